@@ -1,0 +1,1 @@
+"""Mission layer: scenarios, world model (structure, sky, GNSS, camera), planning and runs."""

@@ -1,0 +1,7 @@
+"""Entry point for ``python -m mission``."""
+
+import sys
+
+from mission.cli import entry_point
+
+sys.exit(entry_point())

@@ -1,0 +1,100 @@
+"""``python -m mission``: the project's main command line."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
+from mission.errors import InputError
+from mission.world import World
+
+DEFAULT_SCENARIO = "along"
+DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
+
+
+def build_parser() -> OneLineArgumentParser:
+    """The argument parser with every subcommand."""
+    parser = OneLineArgumentParser(prog="python -m mission", description=__doc__)
+    commands = parser.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=OneLineArgumentParser
+    )
+
+    world = commands.add_parser("world", help="inspect a scenario's world (GNSS, structure, zones)")
+    world.add_argument(
+        "scenario",
+        nargs="?",
+        default=DEFAULT_SCENARIO,
+        help="embedded scenario name (along, wall) or YAML path",
+    )
+    world.add_argument(
+        "--at",
+        nargs=3,
+        type=float,
+        metavar=("X", "Y", "Z"),
+        help="print GNSS facts at this ENU point as one JSON object",
+    )
+    world.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="draw structure, zones, sky plot and sigma_0 slices",
+    )
+
+    run = commands.add_parser("run", help="run a mission (for now: the scenario's world summary)")
+    run.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Parse arguments and dispatch to the chosen command."""
+    args = build_parser().parse_args(argv)
+    if args.command == "world":
+        return _world(args)
+    if args.command == "run":
+        return _run(args)
+    raise AssertionError(args.command)
+
+
+def _world(args) -> int:
+    point = parse_point(args.at, "--at") if args.at is not None else None
+    if args.plot is not None:
+        _check_output_path(args.plot, "--plot", ".png")
+    world = World.load(args.scenario)
+    if point is not None:
+        from mission.world_report import point_report
+
+        print(json.dumps(point_report(world, np.array(point))))
+    else:
+        from mission.world_report import summary_text
+
+        print(summary_text(world))
+    if args.plot is not None:
+        from mission.world_plot import plot_world
+
+        plot_world(world, np.array(point or DEFAULT_PLOT_POINT), args.plot)
+    return 0
+
+
+def _run(args) -> int:
+    from mission.world_report import summary_text
+
+    world = World.load(args.scenario)
+    print(summary_text(world))
+    print("\nThe mission runner (vehicles + ground station) is not built yet; see issue 6.")
+    return 0
+
+
+def _check_output_path(path: Path, flag: str, suffix: str) -> None:
+    if path.suffix.lower() != suffix:
+        raise InputError("command line", flag, f"{path}: the file name must end in {suffix}")
+    if not path.parent.resolve().is_dir():
+        raise InputError("command line", flag, f"{path}: directory {path.parent} does not exist")
+
+
+def entry_point(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI with one-line errors and exit status 2 on bad input."""
+    return run_guarded(main, argv)

@@ -1,0 +1,41 @@
+"""Shared pieces of the project's command-line interfaces: one-line errors, exit status 2."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+
+from mission.errors import InputError
+
+EXIT_BAD_INPUT = 2
+
+
+class OneLineArgumentParser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are a single line on stderr and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        """Report a usage error on one line and exit with status 2."""
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        sys.exit(EXIT_BAD_INPUT)
+
+
+def run_guarded(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
+    """Run ``main``; turn bad input into one line on stderr and status 2, Ctrl-C into 130."""
+    try:
+        return main(argv)
+    except InputError as error:
+        sys.stderr.write(f"error: {error}\n")
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        sys.stderr.write("interrupted\n")
+        return 130
+
+
+def parse_point(values: Sequence[float], flag: str) -> tuple[float, float, float]:
+    """Validate a three-number point given on the command line."""
+    import math
+
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise InputError("command line", flag, "expects three finite numbers X Y Z")
+    return float(values[0]), float(values[1]), float(values[2])

@@ -1,0 +1,169 @@
+"""GNSS of a support UAV (paper 3.1.1): visibility, dilution of precision, noisy fixes.
+
+One receiver-clock unknown per constellation that has a visible satellite, so GPS+GLONASS
+gives the 5-column geometry matrix of MODEL.md; a constellation with no visible satellite
+contributes no column (a receiver does not solve for a clock it cannot observe).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.settings import GnssSettings
+from mission.sky import Sky
+from mission.structure import Structure
+
+_CHUNK = 20_000
+_MIN_EIGENVALUE = 1e-9
+
+
+@dataclass(frozen=True)
+class GnssGeometry:
+    """Satellite geometry at N points: which satellites are visible and cov_geom where fixed."""
+
+    visible: np.ndarray
+    has_fix: np.ndarray
+    cov_geom: np.ndarray
+
+    @property
+    def n_visible(self) -> np.ndarray:
+        """Number of visible satellites at each point."""
+        return self.visible.sum(axis=1)
+
+    @property
+    def pdop(self) -> np.ndarray:
+        """Position dilution of precision (NaN without a fix)."""
+        return np.sqrt(np.trace(self.cov_geom, axis1=1, axis2=2))
+
+    @property
+    def hdop(self) -> np.ndarray:
+        """Horizontal dilution of precision (NaN without a fix)."""
+        return np.sqrt(self.cov_geom[:, 0, 0] + self.cov_geom[:, 1, 1])
+
+    @property
+    def vdop(self) -> np.ndarray:
+        """Vertical dilution of precision (NaN without a fix)."""
+        return np.sqrt(self.cov_geom[:, 2, 2])
+
+
+class GnssModel:
+    """Sky + structure + ranging noise: everything needed for Sigma_GNSS and sampled fixes."""
+
+    def __init__(self, sky: Sky, structure: Structure, settings: GnssSettings) -> None:
+        self.sky = sky
+        self.structure = structure
+        self.settings = settings
+        self._directions = sky.directions_enu
+        self._rows = _geometry_rows(
+            self._directions, sky.constellation_index(), len(sky.constellations)
+        )
+
+    def visibility(self, points: np.ndarray) -> np.ndarray:
+        """(N, S) True where the satellite is above the mask and its ray misses the structure."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        n_points, n_sats = len(points), len(self.sky.sv)
+        visible = np.zeros((n_points, n_sats), dtype=bool)
+        masked_in = np.flatnonzero(self.sky.above_mask)
+        if len(masked_in) == 0 or n_points == 0:
+            return visible
+        origins = np.repeat(points, len(masked_in), axis=0)
+        directions = np.tile(self._directions[masked_in], (n_points, 1))
+        blocked = self.structure.rays_blocked(origins, directions).reshape(n_points, -1)
+        visible[:, masked_in] = ~blocked
+        return visible
+
+    def geometry(self, points: np.ndarray) -> GnssGeometry:
+        """Visibility and geometric covariance cov_geom (top-left 3x3 of (H^T H)^-1)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        parts = [
+            self._geometry_chunk(points[start : start + _CHUNK])
+            for start in range(0, max(len(points), 1), _CHUNK)
+        ]
+        return GnssGeometry(
+            visible=np.concatenate([p[0] for p in parts]),
+            has_fix=np.concatenate([p[1] for p in parts]),
+            cov_geom=np.concatenate([p[2] for p in parts]),
+        )
+
+    def geometry_from_visibility(self, visible: np.ndarray) -> GnssGeometry:
+        """cov_geom for given visibility masks (N, S), without ray casting."""
+        has_fix, cov = _covariance_from_visibility(
+            visible, self._rows, self.sky.constellation_index(), len(self.sky.constellations)
+        )
+        return GnssGeometry(visible=visible, has_fix=has_fix, cov_geom=cov)
+
+    def _geometry_chunk(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        geometry = self.geometry_from_visibility(self.visibility(points))
+        return geometry.visible, geometry.has_fix, geometry.cov_geom
+
+    def sigma_gnss(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(has_fix (N,), Sigma_GNSS (N, 3, 3)) with NaN where there is no fix."""
+        geometry = self.geometry(points)
+        return geometry.has_fix, self.settings.sigma_uere_m**2 * geometry.cov_geom
+
+    def sigma0(self, points: np.ndarray) -> np.ndarray:
+        """sqrt(tr Sigma_GNSS) = sigma_UERE * PDOP at each point (NaN without a fix)."""
+        return self.settings.sigma_uere_m * self.geometry(points).pdop
+
+    def sample_fix(
+        self, point: np.ndarray, rng: np.random.Generator, offset_m: np.ndarray | None = None
+    ) -> GnssFix:
+        """One fix at true position ``point``: truth + N(0, Sigma_GNSS) + multipath offset."""
+        point = np.asarray(point, dtype=float).reshape(3)
+        geometry = self.geometry(point[None])
+        n_visible = int(geometry.n_visible[0])
+        if not geometry.has_fix[0]:
+            return GnssFix(False, None, None, n_visible, None, None)
+        covariance = self.settings.sigma_uere_m**2 * geometry.cov_geom[0]
+        noise = np.linalg.cholesky(covariance) @ rng.standard_normal(3)
+        offset = np.zeros(3) if offset_m is None else np.asarray(offset_m, dtype=float)
+        return GnssFix(
+            True,
+            point + noise + offset,
+            covariance,
+            n_visible,
+            float(geometry.hdop[0]),
+            float(geometry.vdop[0]),
+        )
+
+
+@dataclass(frozen=True)
+class GnssFix:
+    """A receiver's output: position (None without fix) and the accuracy it believes in."""
+
+    has_fix: bool
+    position_m: np.ndarray | None
+    covariance_m2: np.ndarray | None
+    n_visible: int
+    hdop: float | None
+    vdop: float | None
+
+
+def _geometry_rows(directions: np.ndarray, system: np.ndarray, n_systems: int) -> np.ndarray:
+    """Rows of H for every satellite: [-e^T, one-hot receiver clock of its constellation]."""
+    clock = np.zeros((len(directions), n_systems))
+    clock[np.arange(len(directions)), system] = 1.0
+    return np.hstack((-directions, clock))
+
+
+def _covariance_from_visibility(
+    visible: np.ndarray, rows: np.ndarray, system: np.ndarray, n_systems: int
+) -> tuple[np.ndarray, np.ndarray]:
+    visible = np.asarray(visible, dtype=bool)
+    weights = visible.astype(float)
+    normal = np.einsum("ns,si,sj->nij", weights, rows, rows)
+    per_system = np.stack([visible[:, system == k].sum(axis=1) for k in range(n_systems)], axis=1)
+    unused = per_system == 0
+    # A clock no satellite observes is not estimated: a unit diagonal decouples its column.
+    for k in range(n_systems):
+        normal[unused[:, k], 3 + k, 3 + k] = 1.0
+    unknowns = 3 + (~unused).sum(axis=1)
+    enough = visible.sum(axis=1) >= unknowns
+    eigen_min = np.linalg.eigvalsh(normal)[:, 0]
+    has_fix = enough & (eigen_min > _MIN_EIGENVALUE)
+    cov = np.full((len(visible), 3, 3), np.nan)
+    if np.any(has_fix):
+        cov[has_fix] = np.linalg.inv(normal[has_fix])[:, :3, :3]
+    return has_fix, cov

@@ -1,0 +1,127 @@
+"""The structure as a triangle mesh, with the ray queries the models need."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from mission.errors import ScenarioError
+from mission.settings import BoxPrimitive, StructureSettings
+
+_EPS = 1e-6
+_MESH_SUFFIXES = (".stl", ".obj", ".ply")
+
+
+class Structure:
+    """A static structure (bridge, wall, ...) that blocks satellite signals and sight lines."""
+
+    def __init__(
+        self,
+        mesh: trimesh.Trimesh,
+        boxes: list[BoxPrimitive],
+        solid_file_mesh: trimesh.Trimesh | None = None,
+    ) -> None:
+        """``mesh`` is everything that occludes; ``boxes`` and a watertight ``solid_file_mesh``
+        answer inside/outside queries."""
+        self.mesh = mesh
+        self.boxes = boxes
+        self._box_min = np.array([b.min_m for b in boxes]).reshape(-1, 3)
+        self._box_max = np.array([b.max_m for b in boxes]).reshape(-1, 3)
+        self._solid_file_mesh = solid_file_mesh
+
+    @property
+    def uses_embree(self) -> bool:
+        """True when ray queries go through Embree."""
+        return type(self.mesh.ray).__module__.endswith("ray_pyembree")
+
+    def rays_blocked(self, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        """For each ray (origin, unit direction), True if it hits the structure anywhere."""
+        origins = np.asarray(origins, dtype=float).reshape(-1, 3)
+        directions = np.asarray(directions, dtype=float).reshape(-1, 3)
+        if len(origins) == 0:
+            return np.zeros(0, dtype=bool)
+        return np.asarray(self.mesh.ray.intersects_any(origins, directions), dtype=bool)
+
+    def segments_blocked(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        """For each segment start -> end, True if the structure lies between the two points."""
+        starts = np.atleast_2d(np.asarray(starts, dtype=float))
+        ends = np.atleast_2d(np.asarray(ends, dtype=float))
+        starts, ends = np.broadcast_arrays(starts, ends)
+        delta = ends - starts
+        length = np.linalg.norm(delta, axis=1)
+        blocked = np.zeros(len(starts), dtype=bool)
+        live = length > _EPS
+        if not np.any(live):
+            return blocked
+        index = np.flatnonzero(live)
+        directions = delta[live] / length[live, None]
+        _, ray_ids, locations = self.mesh.ray.intersects_id(
+            starts[live], directions, multiple_hits=True, return_locations=True
+        )
+        if len(ray_ids):
+            hit_distance = np.linalg.norm(locations - starts[live][ray_ids], axis=1)
+            before_end = hit_distance < length[live][ray_ids] - _EPS
+            blocked[index[ray_ids[before_end]]] = True
+        return blocked | self.contains(starts) | self.contains(ends)
+
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """True for points inside a solid of the structure (boxes, or a watertight mesh file)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        inside = np.zeros(len(points), dtype=bool)
+        if len(self._box_min):
+            inside |= np.any(
+                np.all(
+                    (points[:, None, :] > self._box_min[None] + _EPS)
+                    & (points[:, None, :] < self._box_max[None] - _EPS),
+                    axis=2,
+                ),
+                axis=1,
+            )
+        if self._solid_file_mesh is not None:
+            inside |= self._solid_file_mesh.contains(points)
+        return inside
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) array: min and max corner of the structure."""
+        return np.asarray(self.mesh.bounds, dtype=float)
+
+
+def build_structure(settings: StructureSettings, source: str = "") -> Structure:
+    """Build the structure's mesh from its primitives and mesh file."""
+    parts = [_box_mesh(box) for box in settings.primitives]
+    solid_file_mesh = None
+    if settings.mesh_file is not None:
+        file_mesh = load_mesh_file(Path(settings.mesh_file), source)
+        parts.append(file_mesh)
+        if file_mesh.is_watertight:
+            solid_file_mesh = file_mesh
+    mesh = trimesh.util.concatenate(parts) if len(parts) > 1 else parts[0]
+    return Structure(mesh, list(settings.primitives), solid_file_mesh)
+
+
+def load_mesh_file(path: Path, source: str = "") -> trimesh.Trimesh:
+    """Load an STL/OBJ/PLY file as one triangle mesh; bad files raise ScenarioError."""
+    where = "world.structure.mesh_file"
+    if path.suffix.lower() not in _MESH_SUFFIXES:
+        raise ScenarioError(source or str(path), where, f"{path}: not an STL, OBJ or PLY file")
+    try:
+        loaded = trimesh.load(str(path), force="mesh", process=True)
+    except Exception as error:  # trimesh raises many types for malformed files
+        raise ScenarioError(
+            source or str(path), where, f"{path}: cannot read mesh ({type(error).__name__})"
+        ) from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise ScenarioError(source or str(path), where, f"{path}: holds no triangles")
+    if not np.all(np.isfinite(loaded.vertices)):
+        raise ScenarioError(source or str(path), where, f"{path}: has non-finite vertices")
+    return loaded
+
+
+def _box_mesh(box: BoxPrimitive) -> trimesh.Trimesh:
+    lo, hi = np.array(box.min_m), np.array(box.max_m)
+    mesh = trimesh.creation.box(extents=hi - lo)
+    mesh.apply_translation((lo + hi) / 2)
+    return mesh

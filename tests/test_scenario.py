@@ -1,0 +1,165 @@
+"""Scenario loading: embedded scenarios, overrides, and one clear error per kind of bad input."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from mission.errors import ScenarioError
+from mission.scenario import embedded_scenario_names, load_scenario
+from mission.world import World
+
+
+def test_both_embedded_scenarios_load():
+    assert {"along", "wall"} <= set(embedded_scenario_names())
+    for name in ("along", "wall"):
+        scenario = load_scenario(name)
+        assert scenario.name == name
+        assert len(scenario.world.zones) == 1
+        assert scenario.world.zones[0].offset_m == (1.0, 0.0, 0.0)
+
+
+def test_model_defaults_reach_the_settings(along):
+    assert along.gnss.sigma_uere_m == 0.10
+    assert along.camera.range_m == 30.0
+    assert (along.fusion.broad_particles, along.fusion.local_particles) == (300, 100)
+    assert (along.map.voxel_size_m, along.map.eta, along.map.neighborhood) == (1.0, 0.3, 1.0)
+    assert along.control.horizon_steps == 5
+    assert along.control.d_max_support_m == pytest.approx(1.0)
+    assert along.run.timeout_s == 900.0
+
+
+def test_user_scenario_overrides_a_subset(write_scenario):
+    path = write_scenario(
+        """
+        extends: wall
+        name: coarse-wall
+        map: {voxel_size_m: 2.0}
+        control: {w_gnss: 20}
+        """
+    )
+    scenario = load_scenario(str(path))
+    assert scenario.name == "coarse-wall"
+    assert scenario.map.voxel_size_m == 2.0 and scenario.map.eta == 0.3
+    assert scenario.control.w_gnss == 20.0 and scenario.control.w_penalty == 100.0
+    assert scenario.world.zones == load_scenario("wall").world.zones
+
+
+def _box_stl(path: Path) -> Path:
+    mesh = trimesh.creation.box(extents=[40.0, 40.0, 1.0])
+    mesh.apply_translation([0.0, 0.0, 10.5])
+    mesh.export(str(path))
+    return path
+
+
+def test_structure_from_a_mesh_file(write_scenario, tmp_path):
+    _box_stl(tmp_path / "roof.stl")
+    path = write_scenario("world: {structure: {mesh_file: roof.stl, primitives: []}}\n")
+    world = World(load_scenario(str(path)))
+    geometry = world.gnss.geometry(np.array([[0.0, 0.0, 5.0], [0.0, 0.0, 15.0]]))
+    assert not geometry.has_fix[0], "under the roof"
+    assert geometry.has_fix[1]
+    assert world.structure.contains(np.array([[0.0, 0.0, 10.5]]))[0]
+
+
+BAD_INPUTS = [
+    ("unknown key", "gnss: {sigma_uere: 0.1}\n", "gnss.sigma_uere", "unknown key"),
+    ("wrong type", "gnss: {sigma_uere_m: fast}\n", "gnss.sigma_uere_m", "expected a number"),
+    ("bool as number", "camera: {range_m: true}\n", "camera.range_m", "expected a number"),
+    ("negative voxel", "map: {voxel_size_m: -1}\n", "map.voxel_size_m", "must be positive"),
+    ("eta above one", "map: {eta: 1.5}\n", "map.eta", "must be in [0, 1]"),
+    (
+        "integer field",
+        "fusion: {broad_particles: 2.5}\n",
+        "fusion.broad_particles",
+        "expected an integer",
+    ),
+    (
+        "zone outside workspace",
+        "world: {zones: [{name: z, min_m: [30, 0, 1], max_m: [31, 1, 2], offset_m: [1, 0, 0]}]}\n",
+        "world.zones[0]",
+        "outside the workspace",
+    ),
+    (
+        "inverted box",
+        "world: {workspace: {min_m: [0, 0, 0], max_m: [-1, 5, 5]}}\n",
+        "world.workspace.max_m",
+        "must exceed min_m",
+    ),
+    (
+        "short vector",
+        "world: {workspace: {min_m: [0, 0]}}\n",
+        "world.workspace.min_m",
+        "expected 3 values",
+    ),
+    (
+        "missing mesh",
+        "world: {structure: {mesh_file: nowhere.stl}}\n",
+        "world.structure.mesh_file",
+        "no such file",
+    ),
+    ("bad epoch", "sky: {epoch_utc: yesterday}\n", "sky.epoch_utc", "ISO-8601"),
+    (
+        "mask out of range",
+        "sky: {elevation_mask_deg: 95}\n",
+        "sky.elevation_mask_deg",
+        "must be in [0, 90)",
+    ),
+    ("unknown base", "extends: nosuch\n", "extends", "no such scenario"),
+    ("bad yaml", "map: {voxel_size_m: [1, 2\n", "line ", "invalid YAML"),
+    ("not a mapping", "- 1\n- 2\n", "", "must hold a mapping"),
+    ("section not mapping", "gnss: 3\n", "gnss", "expected a mapping"),
+    (
+        "empty structure",
+        "world: {structure: {primitives: []}}\n",
+        "world.structure.primitives",
+        "at least one primitive",
+    ),
+]
+
+
+@pytest.mark.parametrize(
+    ("case", "text", "field", "problem"), BAD_INPUTS, ids=[c[0] for c in BAD_INPUTS]
+)
+def test_bad_input_names_file_field_and_problem(write_scenario, case, text, field, problem):
+    path = write_scenario(text)
+    with pytest.raises(ScenarioError) as caught:
+        World(load_scenario(str(path)))
+    message = str(caught.value)
+    assert str(path) in message
+    assert field in message
+    assert problem in message
+    assert "\n" not in message
+
+
+def test_malformed_mesh_file_is_reported(write_scenario, tmp_path):
+    (tmp_path / "broken.stl").write_bytes(b"solid nothing\nthis is not an stl\n")
+    path = write_scenario("world: {structure: {mesh_file: broken.stl}}\n")
+    with pytest.raises(ScenarioError, match=r"world\.structure\.mesh_file: .*broken\.stl"):
+        World(load_scenario(str(path)))
+
+
+def test_unknown_epoch_in_table(write_scenario):
+    path = write_scenario('sky: {epoch_utc: "2021-10-01T05:00:00Z"}\n')
+    with pytest.raises(ScenarioError, match="no satellites at 2021-10-01T05:00:00Z"):
+        World(load_scenario(str(path)))
+
+
+def test_cli_prints_one_line_and_exits_2(write_scenario, tmp_path):
+    path = write_scenario("map: {voxel_size_m: -1}\n")
+    result = subprocess.run(
+        [sys.executable, "-m", "mission", "world", str(path), "--plot", str(tmp_path / "w.png")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1
+    assert "map.voxel_size_m" in result.stderr and str(path) in result.stderr
+    assert result.stdout == ""
+    assert list(tmp_path.glob("*.png")) == [] and list(tmp_path.glob(".*part")) == []
