@@ -273,16 +273,60 @@ class ControlSettings:
 
 @dataclass(frozen=True)
 class RunSettings:
-    """How a run goes: time limit, vehicle realism, failsafe."""
+    """How a run goes: its time limit and the simulated epoch of t = 0."""
 
     timeout_s: float
-    tracking_noise_m: float
-    failsafe_s: float
+    epoch_utc: str
 
     def __post_init__(self) -> None:
-        _positive(self, "timeout_s", "failsafe_s")
-        _non_negative(self, "tracking_noise_m")
+        _positive(self, "timeout_s")
         _require(math.isfinite(self.timeout_s), "timeout_s", "must be finite")
+        try:
+            datetime.fromisoformat(self.epoch_utc.replace("Z", "+00:00"))
+        except ValueError:
+            raise FieldProblem("epoch_utc", f"not an ISO-8601 time: {self.epoch_utc!r}") from None
+
+    @property
+    def epoch_unix_s(self) -> float:
+        """The epoch as seconds since 1970 (UTC)."""
+        return datetime.fromisoformat(self.epoch_utc.replace("Z", "+00:00")).timestamp()
+
+
+@dataclass(frozen=True)
+class TaskSettings:
+    """The task: how many support UAVs accompany the work UAV."""
+
+    supports: int
+
+    def __post_init__(self) -> None:
+        _require(1 <= self.supports <= 50, "supports", f"must be in 1..50, got {self.supports}")
+
+
+@dataclass(frozen=True)
+class VehicleSettings:
+    """A simulated vehicle: realism, failsafe, telemetry rates and protocol timing.
+
+    Rates are in simulated time; the ``*_wall_s`` timeouts are wall-clock seconds, divided by
+    the speed-up in real-time mode.
+    """
+
+    tracking_noise_m: float
+    failsafe_s: float
+    heartbeat_hz: float
+    status_hz: float
+    sensor_hz: float
+    lockstep_timeout_wall_s: float
+    truth_timeout_wall_s: float
+    mission_timeout_wall_s: float
+    mission_retries: int
+    mission_capacity: int
+
+    def __post_init__(self) -> None:
+        _non_negative(self, "tracking_noise_m")
+        _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
+        _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
+        _require(self.mission_retries >= 0, "mission_retries", "must not be negative")
+        _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")
 
 
 @dataclass(frozen=True)
@@ -300,3 +344,5 @@ class Scenario:
     map: MapSettings
     control: ControlSettings
     run: RunSettings
+    task: TaskSettings
+    vehicle: VehicleSettings

@@ -32,6 +32,7 @@ def test_model_defaults_reach_the_settings(along):
     assert along.control.horizon_steps == 5
     assert along.control.d_max_support_m == pytest.approx(1.0)
     assert along.run.timeout_s == 900.0
+    assert along.task.supports == 3 and along.vehicle.failsafe_s == 2.0
 
 
 def test_user_scenario_overrides_a_subset(write_scenario):

@@ -1,0 +1,169 @@
+"""MAVLink 2 over UDP for both sides: encoding with pymavlink's generated classes, per-datagram
+decoding that survives garbage, and a non-blocking socket endpoint with counters."""
+
+from __future__ import annotations
+
+import select
+import socket
+import time
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+Address = tuple[str, int]
+MAX_DATAGRAM = 65_535
+
+
+@dataclass
+class LinkCounters:
+    """What a link has seen; reported by the processes at exit and in SYS_STATUS."""
+
+    datagrams_in: int = 0
+    packets_in: int = 0
+    bad_datagrams: int = 0
+    bad_packets: int = 0
+    packets_out: int = 0
+    send_errors: int = 0
+    rejected: dict[str, int] = field(default_factory=dict)
+
+    def reject(self, reason: str) -> None:
+        """Count a well-formed message that was refused (out-of-range values, wrong mask...)."""
+        self.rejected[reason] = self.rejected.get(reason, 0) + 1
+
+    def summary(self) -> str:
+        """One line for logs."""
+        rejected = ", ".join(f"{k} {v}" for k, v in sorted(self.rejected.items())) or "none"
+        return (
+            f"in {self.packets_in} packets / {self.datagrams_in} datagrams, "
+            f"bad {self.bad_datagrams} datagrams ({self.bad_packets} packets), "
+            f"out {self.packets_out}, rejected: {rejected}"
+        )
+
+
+class MavlinkCodec:
+    """One MAVLink 2 identity (sysid, compid): packs outgoing and parses incoming datagrams."""
+
+    def __init__(self, system_id: int, component_id: int) -> None:
+        self.mav = mavlink2.MAVLink(None, srcSystem=system_id, srcComponent=component_id)
+        self.mav.robust_parsing = True
+
+    @property
+    def system_id(self) -> int:
+        """This endpoint's system id."""
+        return int(self.mav.srcSystem)
+
+    def encode(self, message: Any) -> bytes:
+        """Pack a generated message object as a MAVLink 2 packet from this identity."""
+        packet = message.pack(self.mav)
+        self.mav.seq = (self.mav.seq + 1) % 256
+        return bytes(packet)
+
+    def decode(self, datagram: bytes) -> tuple[list[Any], int]:
+        """Parse one UDP datagram into messages; return them and the number of bad packets.
+
+        Parser state never carries over between datagrams: UDP keeps packets whole, so bytes
+        left over at the end of a datagram are a truncated packet, counted as bad.
+        """
+        self._reset()
+        try:
+            parsed = self.mav.parse_buffer(bytes(datagram)) or []
+        except Exception:  # pymavlink raises several types on malformed input
+            self._reset()
+            return [], 1
+        good = [m for m in parsed if m.get_type() != "BAD_DATA"]
+        bad = len(parsed) - len(good)
+        if len(self.mav.buf) - self.mav.buf_index > 0:
+            bad += 1
+        self._reset()
+        return good, bad
+
+    def _reset(self) -> None:
+        mav = self.mav
+        mav.buf = bytearray()
+        mav.buf_index = 0
+        mav.expected_length = mavlink2.HEADER_LEN_V1 + 2
+        mav.have_prefix_error = False
+
+
+class UdpEndpoint:
+    """A non-blocking UDP socket carrying MAVLink for one identity."""
+
+    def __init__(self, codec: MavlinkCodec, bind: Address = ("127.0.0.1", 0)) -> None:
+        self.codec = codec
+        self.counters = LinkCounters()
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
+        self.sock.bind(bind)
+        self.sock.setblocking(False)
+
+    @property
+    def address(self) -> Address:
+        """The bound (host, port)."""
+        host, port = self.sock.getsockname()[:2]
+        return host, port
+
+    def fileno(self) -> int:
+        """For select()."""
+        return self.sock.fileno()
+
+    def receive(self) -> list[tuple[Any, Address]]:
+        """Drain the socket; return (message, sender) pairs and count what was bad."""
+        received: list[tuple[Any, Address]] = []
+        while True:
+            try:
+                datagram, sender = self.sock.recvfrom(MAX_DATAGRAM)
+            except (BlockingIOError, InterruptedError):
+                return received
+            except OSError:  # e.g. ICMP port unreachable surfaced on Linux
+                continue
+            self.counters.datagrams_in += 1
+            messages, bad = self.codec.decode(datagram)
+            if bad:
+                self.counters.bad_datagrams += 1
+                self.counters.bad_packets += bad
+            self.counters.packets_in += len(messages)
+            received.extend((m, sender) for m in messages)
+
+    def send(self, message: Any, destinations: list[Address] | tuple[Address, ...]) -> bytes:
+        """Encode once and send to every destination; return the packet bytes."""
+        packet = self.codec.encode(message)
+        for destination in destinations:
+            try:
+                self.sock.sendto(packet, destination)
+                self.counters.packets_out += 1
+            except OSError:
+                self.counters.send_errors += 1
+        return packet
+
+    def close(self) -> None:
+        """Close the socket."""
+        self.sock.close()
+
+
+def parse_address(text: str, what: str = "address") -> Address:
+    """'HOST:PORT' -> (host, port); ValueError with a clear message otherwise."""
+    host, sep, port_text = text.rpartition(":")
+    if not sep or not host or not port_text.isdigit() or not 0 < int(port_text) < 65536:
+        raise ValueError(f"{what} must look like HOST:PORT, got {text!r}")
+    return host, int(port_text)
+
+
+class MessageQueue:
+    """One message at a time from an endpoint, keeping what a drain read beyond the first."""
+
+    def __init__(self, endpoint: UdpEndpoint) -> None:
+        self.endpoint = endpoint
+        self._pending: deque[tuple[Any, Address]] = deque()
+
+    def next(self, timeout_s: float) -> tuple[Any, Address] | None:
+        """The next (message, sender), waiting at most ``timeout_s``; None on timeout."""
+        deadline = time.monotonic() + timeout_s
+        while not self._pending:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return None
+            select.select([self.endpoint], [], [], left)
+            self._pending.extend(self.endpoint.receive())
+        return self._pending.popleft()

@@ -1,0 +1,158 @@
+"""``python -m vehicle_sim``: start one simulated UAV."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+
+from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
+from mission.errors import InputError
+from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
+from mission.world import World
+from vehicle_sim.identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
+from vehicle_sim.server import ClockSettings, VehicleServer, install_signal_handlers
+from vehicle_sim.truth_link import TruthReceiver, TruthSender
+from vehicle_sim.vehicle import Vehicle
+
+
+def build_parser() -> OneLineArgumentParser:
+    """Arguments of a vehicle process."""
+    parser = OneLineArgumentParser(prog="python -m vehicle_sim", description=__doc__)
+    parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
+    parser.add_argument("--vehicle", required=True, help="work or support-N")
+    parser.add_argument("--host", default="127.0.0.1", help="address to listen on")
+    parser.add_argument(
+        "--port", type=int, help=f"MAVLink UDP port (default {BASE_PORT} + instance; 0: any free)"
+    )
+    parser.add_argument(
+        "--out",
+        action="append",
+        default=[],
+        metavar="HOST:PORT",
+        help="also stream to this address (repeatable), as SITL does for a GCS",
+    )
+    parser.add_argument("--seed", type=int, default=0)
+    pacing = parser.add_mutually_exclusive_group()
+    pacing.add_argument(
+        "--lockstep",
+        action="store_true",
+        help="step when the ground station's clock ticks (the default)",
+    )
+    pacing.add_argument("--speedup", type=float, help="real time, this many times faster")
+    parser.add_argument(
+        "--home",
+        nargs=3,
+        type=float,
+        metavar=("X", "Y", "Z"),
+        help="start position, ENU metres (default: first planned waypoint)",
+    )
+    parser.add_argument(
+        "--truth-port", type=int, help="support: port for the work UAV's truth (default port + 100)"
+    )
+    parser.add_argument(
+        "--truth-out",
+        action="append",
+        default=None,
+        metavar="HOST:PORT",
+        help="work: send truth here (default: each support's default truth port)",
+    )
+    parser.add_argument(
+        "--exit-with-parent",
+        action="store_true",
+        help="stop when the process that started this one dies",
+    )
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Start the vehicle and serve until terminated."""
+    args = build_parser().parse_args(argv)
+    identity = _identity(args.vehicle)
+    if args.speedup is not None and not (0 < args.speedup <= 1000):
+        raise InputError("command line", "--speedup", "must be in (0, 1000]")
+    port = args.port if args.port is not None else identity.default_port()
+    _check_port(port, "--port", allow_any=True)
+    outs = [_address(text, "--out") for text in args.out]
+    world = World.load(args.scenario)
+    scenario = world.scenario
+    home = np.array(parse_point(args.home, "--home")) if args.home else _planned_home(identity)
+    clock = ClockSettings(lockstep=args.speedup is None, speedup=args.speedup or 1.0)
+
+    truth_sender = truth_receiver = None
+    if identity.is_work:
+        if args.truth_out is None:
+            supports = range(1, scenario.task.supports + 1) if port else range(0)
+            destinations = [(args.host, port + TRUTH_PORT_OFFSET + n) for n in supports]
+        else:
+            destinations = [_address(text, "--truth-out") for text in args.truth_out]
+        truth_sender = TruthSender(identity.system_id, destinations)
+    try:
+        endpoint = UdpEndpoint(MavlinkCodec(identity.system_id, 1), (args.host, port))
+        if not identity.is_work:
+            truth_port = args.truth_port
+            if truth_port is None:
+                truth_port = port + TRUTH_PORT_OFFSET if port else 0
+            _check_port(truth_port, "--truth-port", allow_any=True)
+            truth_receiver = TruthReceiver(truth_port, args.host)
+    except OSError as error:
+        raise InputError("command line", "--port", f"cannot listen: {error.strerror}") from None
+
+    server = VehicleServer(
+        endpoint, outs, clock, truth_sender, truth_receiver, args.exit_with_parent
+    )
+    vehicle = Vehicle(
+        identity, scenario, world, home, args.seed, server.broadcast, speedup=clock.speedup
+    )
+    server.attach(vehicle)
+    install_signal_handlers(server.stop, args.exit_with_parent)
+    pacing = "lockstep" if clock.lockstep else f"real time x{clock.speedup:g}"
+    host, bound = endpoint.address
+    truth = f", truth port {truth_receiver.endpoint.address[1]}" if truth_receiver else ""
+    print(
+        f"vehicle {identity.name} (sysid {identity.system_id}) listening on {host}:{bound}"
+        f"{truth}, {pacing}, home {home.round(3).tolist()}, scenario {scenario.name}",
+        file=sys.stderr,
+        flush=True,
+    )
+    try:
+        server.run()
+    finally:
+        print(server.summary(), file=sys.stderr, flush=True)
+        endpoint.close()
+        for channel in (truth_sender, truth_receiver):
+            if channel is not None:
+                channel.close()
+    return 0
+
+
+def _identity(name: str) -> VehicleIdentity:
+    try:
+        return VehicleIdentity.parse(name)
+    except ValueError as error:
+        raise InputError("command line", "--vehicle", str(error)) from None
+
+
+def _address(text: str, flag: str):
+    try:
+        return parse_address(text, flag)
+    except ValueError as error:
+        raise InputError("command line", flag, str(error)) from None
+
+
+def _check_port(port: int, flag: str, allow_any: bool = False) -> None:
+    lowest = 0 if allow_any else 1
+    if not lowest <= port < 65536:
+        raise InputError("command line", flag, f"port must be in {lowest}..65535, got {port}")
+
+
+def _planned_home(identity: VehicleIdentity) -> np.ndarray:
+    raise InputError(
+        "command line", "--home", f"no planned waypoints for {identity.name} yet: give --home X Y Z"
+    )
+
+
+def entry_point(argv: Sequence[str] | None = None) -> int:
+    """Run with one-line errors and exit status 2 on bad input."""
+    return run_guarded(main, argv)

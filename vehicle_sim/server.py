@@ -1,0 +1,247 @@
+"""The vehicle process: sockets, peers, the simulation clock and the truth channel.
+
+Stepping lives in :class:`~vehicle_sim.vehicle.Vehicle`; this module only decides *when* to step
+(BlueSky's split between simulation and pacing):
+
+- lockstep: the ground station is the master clock. A SYSTEM_TIME from it (time_boot_ms = T)
+  means "advance to T". With no tick for ``lockstep_timeout_wall_s`` the vehicle advances one
+  step alone, so a lost packet cannot freeze it; before the first tick it only sends heartbeats.
+- real time: one step every ``t_cont / speedup`` wall seconds.
+
+Each step ends with SYSTEM_TIME (the step marker the ground station waits for).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import math
+import os
+import select
+import signal
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from mission.mavlink_udp import Address, UdpEndpoint
+from vehicle_sim.truth_link import TruthReceiver, TruthSender
+from vehicle_sim.vehicle import Vehicle
+
+PEER_EXPIRY_WALL_S = 30.0
+MAX_WAIT_WALL_S = 0.1
+IDLE_HEARTBEAT_WALL_S = 1.0
+
+
+@dataclass(frozen=True)
+class ClockSettings:
+    """How simulated time advances."""
+
+    lockstep: bool
+    speedup: float = 1.0
+
+
+@dataclass
+class ServerStats:
+    """What the process reports at exit."""
+
+    auto_steps: int = 0
+    truth_waits_timed_out: int = 0
+    peers_seen: set[Address] = field(default_factory=set)
+
+
+class VehicleServer:
+    """Runs one vehicle: receives, steps, publishes until asked to stop."""
+
+    def __init__(
+        self,
+        endpoint: UdpEndpoint,
+        outs: list[Address],
+        clock: ClockSettings,
+        truth_sender: TruthSender | None = None,
+        truth_receiver: TruthReceiver | None = None,
+        exit_with_parent: bool = False,
+    ) -> None:
+        self.endpoint = endpoint
+        self.outs = list(outs)
+        self.clock = clock
+        self.truth_sender = truth_sender
+        self.truth_receiver = truth_receiver
+        self.exit_with_parent = exit_with_parent
+        self.peers: dict[Address, float] = {}
+        self.stats = ServerStats()
+        self.vehicle: Vehicle | None = None
+        self.stopping = False
+        self._requested_s = 0.0
+        self._started = False
+        self._last_tick_wall = 0.0
+        self._origin_wall = 0.0
+        self._last_idle_heartbeat = -math.inf
+        self._pending_deadline: float | None = None
+        self._parent = os.getppid()
+
+    def attach(self, vehicle: Vehicle) -> None:
+        """Connect the vehicle whose messages this server carries."""
+        self.vehicle = vehicle
+
+    def broadcast(self, message: Any) -> None:
+        """Send a message to every peer that has talked to us and every --out address."""
+        self.endpoint.send(message, [*self.peers, *self.outs])
+
+    # -- main loop --------------------------------------------------------------------------
+    def run(self) -> None:
+        """Serve until stop() or a signal."""
+        assert self.vehicle is not None
+        self._origin_wall = time.monotonic()
+        sources: list[Any] = [self.endpoint]
+        if self.truth_receiver is not None:
+            sources.append(self.truth_receiver)
+        while not self.stopping:
+            now = time.monotonic()
+            wait = max(0.0, min(MAX_WAIT_WALL_S, self._next_deadline(now) - now))
+            readable, _, _ = select.select(sources, [], [], wait)
+            now = time.monotonic()
+            if self.truth_receiver is not None and self.truth_receiver in readable:
+                self.truth_receiver.drain()
+            if self.endpoint in readable:
+                for message, sender in self.endpoint.receive():
+                    self._on_message(message, sender, now)
+            self.vehicle.mission.tick(now)
+            self._advance(now)
+            self._idle_heartbeat(now)
+            self._expire_peers(now)
+            if self.exit_with_parent and os.getppid() != self._parent:
+                self.stopping = True
+
+    def stop(self, *_: Any) -> None:
+        """Ask the loop to finish (signal handler)."""
+        self.stopping = True
+
+    def _next_deadline(self, now: float) -> float:
+        vehicle = self.vehicle
+        assert vehicle is not None
+        if self._pending_deadline is not None:
+            return min(self._pending_deadline, now + 0.005)
+        if self.clock.lockstep:
+            if self._started and self._requested_s > vehicle.sim_time_s + 1e-9:
+                return now
+            if self._started:
+                return self._last_tick_wall + vehicle.scenario.vehicle.lockstep_timeout_wall_s
+            return self._last_idle_heartbeat + IDLE_HEARTBEAT_WALL_S
+        step_wall = vehicle.step_s / self.clock.speedup
+        return self._origin_wall + (vehicle.steps + 1) * step_wall
+
+    def _on_message(self, message: Any, sender: Address, now: float) -> None:
+        vehicle = self.vehicle
+        assert vehicle is not None
+        if message.get_srcSystem() == vehicle.identity.system_id:
+            return  # our own echo (e.g. through a mirror)
+        self.peers[sender] = now
+        self.stats.peers_seen.add(sender)
+        if message.get_type() == "SYSTEM_TIME":
+            if self.clock.lockstep and 0 < message.time_boot_ms < 2**32 - 1:
+                self._requested_s = max(self._requested_s, message.time_boot_ms / 1000.0)
+                self._started = True
+                self._last_tick_wall = now
+            return
+        try:
+            vehicle.handle(message, now)
+        except Exception as error:  # a malformed message never kills the vehicle
+            vehicle.counters.reject(f"handler error {type(error).__name__}")
+
+    # -- stepping ---------------------------------------------------------------------------
+    def _advance(self, now: float) -> None:
+        vehicle = self.vehicle
+        assert vehicle is not None
+        if self._pending_deadline is not None and not self._finish_pending(now):
+            return
+        if self.clock.lockstep:
+            if not self._started:
+                return
+            timeout = vehicle.scenario.vehicle.lockstep_timeout_wall_s
+            idle = self._requested_s <= vehicle.sim_time_s + 1e-9
+            if idle and now - self._last_tick_wall > timeout:
+                self._requested_s = vehicle.sim_time_s + vehicle.step_s
+                self._last_tick_wall = now
+                self.stats.auto_steps += 1
+            while self._requested_s > vehicle.sim_time_s + 1e-9:
+                if not self._do_step(now):
+                    return
+        else:
+            due = math.floor((now - self._origin_wall) * self.clock.speedup / vehicle.step_s + 1e-9)
+            while vehicle.steps < due:
+                if not self._do_step(now):
+                    return
+
+    def _do_step(self, now: float) -> bool:
+        """One step; False if its publication waits for the work UAV's truth."""
+        vehicle = self.vehicle
+        assert vehicle is not None
+        vehicle.step()
+        if self.truth_sender is not None:
+            self.truth_sender.publish(vehicle.kinematics.truth, vehicle.time_boot_ms)
+        if self.truth_receiver is None or not vehicle.sensor_due():
+            vehicle.publish(None)
+            return True
+        self.truth_receiver.drain()
+        truth = self.truth_receiver.exact(vehicle.time_boot_ms)
+        if truth is None and self.clock.lockstep:
+            timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
+            self._pending_deadline = now + timeout
+            return False
+        vehicle.publish(
+            truth if truth is not None else self.truth_receiver.estimate(vehicle.time_boot_ms)
+        )
+        return True
+
+    def _finish_pending(self, now: float) -> bool:
+        vehicle, receiver = self.vehicle, self.truth_receiver
+        assert vehicle is not None and receiver is not None and self._pending_deadline is not None
+        truth = receiver.exact(vehicle.time_boot_ms)
+        if truth is None and now < self._pending_deadline:
+            return False
+        if truth is None:
+            self.stats.truth_waits_timed_out += 1
+            truth = receiver.estimate(vehicle.time_boot_ms)
+        self._pending_deadline = None
+        vehicle.publish(truth)
+        return True
+
+    def _idle_heartbeat(self, now: float) -> None:
+        if (
+            self.clock.lockstep
+            and not self._started
+            and now - self._last_idle_heartbeat >= IDLE_HEARTBEAT_WALL_S
+        ):
+            assert self.vehicle is not None
+            self.broadcast(self.vehicle.heartbeat())
+            self._last_idle_heartbeat = now
+
+    def _expire_peers(self, now: float) -> None:
+        for peer, seen in list(self.peers.items()):
+            if now - seen > PEER_EXPIRY_WALL_S:
+                del self.peers[peer]
+
+    def summary(self) -> str:
+        """One line for the log at exit."""
+        vehicle = self.vehicle
+        assert vehicle is not None
+        stale = self.truth_receiver.stale_uses if self.truth_receiver else 0
+        return (
+            f"{vehicle.identity.name}: {vehicle.steps} steps to t={vehicle.sim_time_s:.1f} s; "
+            f"link {self.endpoint.counters.summary()}; vehicle rejected: "
+            f"{dict(sorted(vehicle.counters.rejected.items())) or 'none'}; "
+            f"auto steps {self.stats.auto_steps}, truth waits timed out "
+            f"{self.stats.truth_waits_timed_out}, stale truth {stale}"
+        )
+
+
+def install_signal_handlers(stop: Callable[..., None], die_with_parent: bool) -> None:
+    """SIGTERM and SIGINT end the loop cleanly; optionally die with the parent (Linux)."""
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, stop)
+    if die_with_parent and sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            libc = ctypes.CDLL("libc.so.6", use_errno=True)
+            libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG

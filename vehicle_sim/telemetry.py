@@ -1,0 +1,194 @@
+"""Builders of the telemetry a simulated vehicle sends (pymavlink generated classes only)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from mission.camera import Observation
+from mission.frames import GeodeticFrame, enu_to_ned
+from mission.gnss import GnssFix
+
+UINT16_UNKNOWN = 65535
+SOFTWARE_VERSION = (0 << 24) | (1 << 16) | (0 << 8) | 255  # 0.1.0, FIRMWARE_VERSION_TYPE_OFFICIAL
+CAPABILITIES = (
+    mavlink2.MAV_PROTOCOL_CAPABILITY_MISSION_INT
+    | mavlink2.MAV_PROTOCOL_CAPABILITY_COMMAND_INT
+    | mavlink2.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_LOCAL_NED
+    | mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+)
+
+
+def _u16(value: float) -> int:
+    return int(min(max(round(value), 0), UINT16_UNKNOWN - 1))
+
+
+def gps_raw_int(
+    fix: GnssFix, frame: GeodeticFrame, time_usec: int, sigma_uere_m: float
+) -> mavlink2.MAVLink_gps_raw_int_message:
+    """GPS_RAW_INT from a receiver fix; accuracy fields from the geometry alone."""
+    if not fix.has_fix or fix.position_m is None:
+        return mavlink2.MAVLink_gps_raw_int_message(
+            time_usec,
+            mavlink2.GPS_FIX_TYPE_NO_FIX,
+            0,
+            0,
+            0,
+            UINT16_UNKNOWN,
+            UINT16_UNKNOWN,
+            UINT16_UNKNOWN,
+            UINT16_UNKNOWN,
+            fix.n_visible,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+        )
+    lat_e7, lon_e7, alt_m = frame.to_degE7(fix.position_m)
+    hdop, vdop = float(fix.hdop or 0.0), float(fix.vdop or 0.0)
+    return mavlink2.MAVLink_gps_raw_int_message(
+        time_usec,
+        mavlink2.GPS_FIX_TYPE_RTK_FIXED,
+        lat_e7,
+        lon_e7,
+        round(alt_m * 1000),
+        _u16(hdop * 100),
+        _u16(vdop * 100),
+        UINT16_UNKNOWN,
+        UINT16_UNKNOWN,
+        fix.n_visible,
+        round(alt_m * 1000),
+        round(sigma_uere_m * hdop * 1000),
+        round(sigma_uere_m * vdop * 1000),
+        0,
+        0,
+        0,
+    )
+
+
+def landing_target(
+    observation: Observation, time_usec: int, target_system: int
+) -> mavlink2.MAVLink_landing_target_message:
+    """LANDING_TARGET with the camera's relative vector in NED, relative to the observer."""
+    if not observation.valid or observation.relative_m is None:
+        return mavlink2.MAVLink_landing_target_message(
+            time_usec,
+            target_system,
+            mavlink2.MAV_FRAME_LOCAL_OFFSET_NED,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            [1, 0, 0, 0],
+            mavlink2.LANDING_TARGET_TYPE_VISION_OTHER,
+            0,
+        )
+    north, east, down = (float(v) for v in enu_to_ned(observation.relative_m))
+    distance = math.sqrt(north**2 + east**2 + down**2)
+    angle_x = math.atan2(east, north)
+    angle_y = math.atan2(-down, math.hypot(north, east))
+    return mavlink2.MAVLink_landing_target_message(
+        time_usec,
+        target_system,
+        mavlink2.MAV_FRAME_LOCAL_OFFSET_NED,
+        angle_x,
+        angle_y,
+        distance,
+        0,
+        0,
+        north,
+        east,
+        down,
+        [1, 0, 0, 0],
+        mavlink2.LANDING_TARGET_TYPE_VISION_OTHER,
+        1,
+    )
+
+
+def local_position_ned(
+    position_enu: np.ndarray, velocity_enu: np.ndarray, time_boot_ms: int
+) -> mavlink2.MAVLink_local_position_ned_message:
+    """LOCAL_POSITION_NED (origin: the scenario's geodetic anchor)."""
+    n, e, d = (float(v) for v in enu_to_ned(position_enu))
+    vn, ve, vd = (float(v) for v in enu_to_ned(velocity_enu))
+    return mavlink2.MAVLink_local_position_ned_message(time_boot_ms, n, e, d, vn, ve, vd)
+
+
+def global_position_int(
+    position_enu: np.ndarray,
+    velocity_enu: np.ndarray,
+    home_enu: np.ndarray,
+    frame: GeodeticFrame,
+    time_boot_ms: int,
+) -> mavlink2.MAVLink_global_position_int_message:
+    """GLOBAL_POSITION_INT of the believed position."""
+    lat_e7, lon_e7, alt_m = frame.to_degE7(position_enu)
+    vn, ve, vd = (round(float(v) * 100) for v in enu_to_ned(velocity_enu))
+    relative_mm = round((float(position_enu[2]) - float(home_enu[2])) * 1000)
+    return mavlink2.MAVLink_global_position_int_message(
+        time_boot_ms, lat_e7, lon_e7, round(alt_m * 1000), relative_mm, vn, ve, vd, UINT16_UNKNOWN
+    )
+
+
+def sim_state(
+    truth_enu: np.ndarray, velocity_enu: np.ndarray, frame: GeodeticFrame
+) -> mavlink2.MAVLink_sim_state_message:
+    """SIM_STATE with the true position (lat_int/lon_int carry centimetre resolution)."""
+    lat, lon, alt = frame.to_geodetic(truth_enu)
+    vn, ve, vd = (float(v) for v in enu_to_ned(velocity_enu))
+    return mavlink2.MAVLink_sim_state_message(
+        1,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        lat,
+        lon,
+        alt,
+        0,
+        0,
+        vn,
+        ve,
+        vd,
+        round(lat * 1e7),
+        round(lon * 1e7),
+    )
+
+
+def autopilot_version(system_id: int) -> mavlink2.MAVLink_autopilot_version_message:
+    """AUTOPILOT_VERSION advertising what this simulator really supports."""
+    return mavlink2.MAVLink_autopilot_version_message(
+        CAPABILITIES,
+        SOFTWARE_VERSION,
+        0,
+        0,
+        0,
+        [0] * 8,
+        [0] * 8,
+        [0] * 8,
+        0,
+        0,
+        system_id,
+        [0] * 18,
+    )
+
+
+def statustext(severity: int, text: str) -> mavlink2.MAVLink_statustext_message:
+    """STATUSTEXT (text cut to the field's 50 bytes)."""
+    return mavlink2.MAVLink_statustext_message(severity, text.encode()[:50], 0, 0)
