@@ -186,7 +186,7 @@ class VehicleServer:
             return True
         self.truth_receiver.drain()
         truth = self.truth_receiver.exact(vehicle.time_boot_ms)
-        if truth is None and self.clock.lockstep:
+        if truth is None and self.clock.lockstep and self.truth_receiver.samples:
             timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
             self._pending_deadline = now + timeout
             return False
@@ -216,6 +216,8 @@ class VehicleServer:
         ):
             assert self.vehicle is not None
             self.broadcast(self.vehicle.heartbeat())
+            if self.truth_sender is not None:  # lets the supports know a work UAV exists
+                self.truth_sender.publish(self.vehicle.kinematics.truth, 0)
             self._last_idle_heartbeat = now
 
     def _expire_peers(self, now: float) -> None:

@@ -38,7 +38,11 @@ class TruthSender:
 
 
 class TruthReceiver:
-    """Support side: keep the work UAV's recent true positions by simulated time."""
+    """Support side: keep the work UAV's recent true positions by simulated time.
+
+    In lockstep a support waits (briefly) for the truth of each step only once it has heard
+    from a work vehicle at all; a support running alone publishes not-valid observations.
+    """
 
     def __init__(self, port: int, host: str = "127.0.0.1") -> None:
         self.endpoint = UdpEndpoint(MavlinkCodec(0, 0), (host, port))

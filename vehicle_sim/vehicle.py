@@ -231,7 +231,7 @@ class Vehicle:
         if not (self.armed and self.mode == modes.GUIDED) or self.failsafe:
             return
         limit = self.scenario.vehicle.failsafe_s
-        if self.sim_time_s - self._last_setpoint_s > limit + 1e-9:
+        if self.sim_time_s - self._last_setpoint_s >= limit - 1e-9:
             self.failsafe = True
             self.kinematics.hold()
             self.notify(

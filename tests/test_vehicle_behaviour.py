@@ -1,0 +1,204 @@
+"""A vehicle process in lockstep, driven through real MAVLink: motion, sensors, failsafe."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from mission.frames import GeodeticFrame, ned_to_enu
+from tests.mav_client import MavClient, last, truth_of
+from tests.processes import vehicle_process
+
+STEP_MS = 500
+QUANTUM_M = 0.012  # 1e-7 degree of latitude is 1.1 cm: SIM_STATE's resolution
+
+
+@pytest.fixture(scope="module")
+def frame(along) -> GeodeticFrame:
+    return GeodeticFrame(along.world.anchor)
+
+
+def test_setpoint_moves_at_the_speed_limit_toward_the_target(frame):
+    home = np.array([0.0, -10.0, 7.0])
+    target = home + np.array([6.0, -8.0, 0.0])  # 10 m away
+    with vehicle_process("support-1", home=tuple(home)) as vehicle:
+        client = MavClient(vehicle.address)
+        client.arm_guided(2)
+        positions = []
+        for k in range(1, 25):
+            client.setpoint(2, target)  # a ground station streams setpoints every cycle
+            positions.append(truth_of(last(client.step_to(STEP_MS * k), "SIM_STATE"), frame))
+        client.close()
+    moves = np.linalg.norm(np.diff([home, *positions], axis=0), axis=1)
+    np.testing.assert_allclose(moves[:19], 0.5, atol=QUANTUM_M)  # 1.0 m/s x 0.5 s
+    direction = (positions[5] - home) / np.linalg.norm(positions[5] - home)
+    np.testing.assert_allclose(direction, (target - home) / 10.0, atol=0.01)
+    np.testing.assert_allclose(positions[-1], target, atol=QUANTUM_M)
+
+
+def test_work_uav_is_slower_and_a_wrong_estimate_moves_the_truth_wrongly(frame):
+    home = np.array([0.0, 0.0, 6.0])
+    error = np.array([0.4, -0.3, 0.2])
+    target = home + np.array([1.0, 0.0, 0.0])
+    with vehicle_process("work", home=tuple(home)) as vehicle:
+        client = MavClient(vehicle.address)
+        client.arm_guided(1)
+        client.estimate(home + error)  # the ground station believes it is elsewhere
+        client.setpoint(1, target)
+        first = truth_of(last(client.step_to(STEP_MS), "SIM_STATE"), frame)
+        for k in range(2, 14):
+            client.setpoint(1, target)
+            messages = client.step_to(STEP_MS * k)
+        client.close()
+    assert np.linalg.norm(first - home) == pytest.approx(0.15, abs=QUANTUM_M)  # 0.3 m/s
+    truth = truth_of(last(messages, "SIM_STATE"), frame)
+    np.testing.assert_allclose(truth, target - error, atol=QUANTUM_M)
+    local = last(messages, "LOCAL_POSITION_NED")
+    believed = ned_to_enu(np.array([local.x, local.y, local.z]))
+    np.testing.assert_allclose(believed, target, atol=1e-4)
+
+
+def _fixes(messages, frame) -> np.ndarray:
+    return np.array(
+        [
+            frame.from_degE7(m.lat, m.lon, m.alt / 1000.0)
+            for m in messages
+            if m.get_type() == "GPS_RAW_INT" and m.fix_type >= 3
+        ]
+    )
+
+
+@pytest.mark.parametrize("inside", [True, False], ids=["in-zone", "open"])
+def test_gps_statistics_follow_the_model_with_bias_only_in_the_zone(along_world, frame, inside):
+    zone = along_world.scenario.world.zones[0]
+    point = (
+        (np.array(zone.min_m) + np.array(zone.max_m)) / 2 if inside else np.array([0.0, -15.0, 8.0])
+    )
+    assert along_world.in_zone(point[None])[0] == inside
+    has_fix, sigma = along_world.gnss.sigma_gnss(point[None])
+    assert has_fix[0]
+    with vehicle_process("support-1", home=tuple(point)) as vehicle:
+        client = MavClient(vehicle.address)
+        messages = [m for k in range(1, 401) for m in client.step_to(STEP_MS * k)]
+        client.close()
+    fixes = _fixes(messages, frame)
+    assert len(fixes) == 400
+    bias = np.array(zone.offset_m) if inside else np.zeros(3)
+    errors = fixes - point
+    standard_error = np.sqrt(np.diag(sigma[0]) / len(fixes))
+    np.testing.assert_array_less(np.abs(errors.mean(axis=0) - bias), 4 * standard_error + 0.006)
+    np.testing.assert_allclose(errors.std(axis=0), np.sqrt(np.diag(sigma[0])), rtol=0.2)
+    gps = last(messages, "GPS_RAW_INT")
+    geometry = along_world.gnss.geometry(point[None])
+    assert gps.h_acc == round(0.10 * geometry.hdop[0] * 1000)
+    assert gps.eph == round(geometry.hdop[0] * 100)
+    assert gps.satellites_visible == int(geometry.n_visible[0])
+
+
+def test_landing_target_is_valid_only_with_a_clear_line_of_sight():
+    work_home = (0.0, 0.0, 6.0)
+    beside, above = (0.0, -9.0, 6.0), (0.0, 0.0, 12.0)
+    with (
+        vehicle_process("support-1", home=beside) as s1,
+        vehicle_process("support-2", home=above) as s2,
+        vehicle_process(
+            "work",
+            "--truth-out",
+            f"127.0.0.1:{s1.truth_port}",
+            "--truth-out",
+            f"127.0.0.1:{s2.truth_port}",
+            home=work_home,
+        ) as work,
+    ):
+        client = MavClient(work.address, s1.address, s2.address)
+        messages = [m for k in range(1, 6) for m in client.step_to(STEP_MS * k)]
+        client.close()
+    seen = last(messages, "LANDING_TARGET", system_id=2)
+    hidden = last(messages, "LANDING_TARGET", system_id=3)
+    assert seen.position_valid == 1 and seen.target_num == 1
+    assert seen.frame == mavlink2.MAV_FRAME_LOCAL_OFFSET_NED
+    relative_enu = ned_to_enu(np.array([seen.x, seen.y, seen.z]))
+    np.testing.assert_allclose(relative_enu, np.array(work_home) - np.array(beside), atol=0.5)
+    assert seen.distance == pytest.approx(np.linalg.norm(relative_enu), rel=1e-5)
+    assert hidden.position_valid == 0
+    assert not any(m.get_type() == "LANDING_TARGET" for m in messages if m.get_srcSystem() == 1)
+
+
+def test_failsafe_holds_after_the_set_time_and_clears(frame):
+    home = np.array([0.0, -10.0, 7.0])
+    with vehicle_process("support-1", home=tuple(home)) as vehicle:
+        client = MavClient(vehicle.address)
+        client.arm_guided(2)
+        client.setpoint(2, home + np.array([50.0, 0.0, 0.0]))
+        texts = []
+        positions = []
+        for k in range(1, 9):  # no setpoint after t = 0: failsafe after 2 s (scenario default)
+            messages = client.step_to(STEP_MS * k)
+            texts += [(k, m.text) for m in messages if m.get_type() == "STATUSTEXT"]
+            positions.append(truth_of(last(messages, "SIM_STATE"), frame))
+        fired = [k for k, text in texts if text.startswith("Failsafe: no setpoint")]
+        assert fired == [5], texts  # checked at the start of the step after 2.0 s
+        assert np.linalg.norm(positions[-1] - positions[4]) < QUANTUM_M, "holds position"
+        heartbeat = last(client.seen, "HEARTBEAT")
+        client.setpoint(2, home + np.array([50.0, 0.0, 0.0]))
+        messages = client.step_to(STEP_MS * 9)
+        moved = truth_of(last(messages, "SIM_STATE"), frame)
+        client.close()
+    assert any(m.get_type() == "STATUSTEXT" and "Failsafe cleared" in m.text for m in client.seen)
+    assert heartbeat.system_status == mavlink2.MAV_STATE_CRITICAL
+    assert np.linalg.norm(moved - positions[-1]) == pytest.approx(0.5, abs=QUANTUM_M)
+
+
+def test_commands_are_acknowledged(frame):
+    with vehicle_process("support-2", "--speedup", "1") as vehicle:
+        client = MavClient(vehicle.address)
+        ok = mavlink2.MAV_RESULT_ACCEPTED
+        assert (
+            client.command(
+                mavlink2.MAV_CMD_REQUEST_MESSAGE,
+                mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION,
+                system_id=3,
+            )
+            == ok
+        )
+        version = last(client.seen, "AUTOPILOT_VERSION")
+        assert version.capabilities & mavlink2.MAV_PROTOCOL_CAPABILITY_MISSION_INT
+        assert version.capabilities & mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        assert (
+            client.command(
+                mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL,
+                mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT,
+                -1,
+                system_id=3,
+            )
+            == ok
+        )
+        client.collect(0.3)
+        assert not [m for m in client.collect(1.5) if m.get_type() == "GPS_RAW_INT"]
+        assert (
+            client.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, 99999, 1e6, system_id=3)
+            == mavlink2.MAV_RESULT_UNSUPPORTED
+        )
+        assert (
+            client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 77, system_id=3)
+            == mavlink2.MAV_RESULT_DENIED
+        )
+        assert (
+            client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 6 << 16, system_id=3) == ok
+        )  # PX4 OFFBOARD means GUIDED here
+        assert client.command(mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 1, system_id=3) == ok
+        heartbeat = client.wait_for("HEARTBEAT", 3.0, where=lambda m: m.base_mode & 128)
+        assert heartbeat is not None and heartbeat.custom_mode == 4
+        assert heartbeat.type == mavlink2.MAV_TYPE_QUADROTOR
+        assert (
+            client.command(mavlink2.MAV_CMD_NAV_TAKEOFF, system_id=3)
+            == mavlink2.MAV_RESULT_UNSUPPORTED
+        )
+        client.setpoint(3, np.zeros(3), type_mask=0)  # velocity and acceleration not ignored
+        text = client.wait_for("STATUSTEXT", 3.0)
+        assert "type_mask" in text.text
+        client.send(mavlink2.MAVLink_timesync_message(0, 123456))
+        sync = client.wait_for("TIMESYNC", 3.0)
+        assert sync.ts1 == 123456 and sync.tc1 > 0
+        client.close()
