@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,11 +95,28 @@ class CameraModel:
     def observe(
         self, observer: np.ndarray, target: np.ndarray, rng: np.random.Generator
     ) -> Observation:
-        """One observation of ``target`` from ``observer`` (true positions)."""
+        """One observation of ``target`` from ``observer`` (true positions).
+
+        The single-vector path of :meth:`observable` and :meth:`sample`, in scalar arithmetic
+        because the vehicles call it every step.
+        """
         observer = np.asarray(observer, dtype=float).reshape(3)
         target = np.asarray(target, dtype=float).reshape(3)
         z = target - observer
-        distance = float(np.linalg.norm(z))
-        if not self.observable(observer, target)[0]:
-            return Observation(False, None, distance)
-        return Observation(True, self.sample(z, rng), distance)
+        d = math.sqrt(float(z @ z))
+        if not 0 < d <= self.settings.range_m:
+            return Observation(False, None, d)
+        if self.structure is not None and self.structure.segments_blocked(observer, target)[0]:
+            return Observation(False, None, d)
+        phi = math.asin(max(-1.0, min(1.0, z[2] / d)))
+        theta = math.atan2(z[1], z[0])
+        cp, sp, ct, st = math.cos(phi), math.sin(phi), math.cos(theta), math.sin(theta)
+        jacobian = np.array(
+            [
+                [cp * ct, -d * sp * ct, -d * cp * st],
+                [cp * st, -d * sp * st, d * cp * ct],
+                [sp, d * cp, 0.0],
+            ]
+        )
+        sigma = np.array([float(self.sigma_d(d)), self._sigma_phi, self._sigma_theta])
+        return Observation(True, z + jacobian @ (sigma * rng.standard_normal(3)), d)

@@ -44,6 +44,15 @@ def build_parser() -> OneLineArgumentParser:
         help="draw structure, zones, sky plot and sigma_0 slices",
     )
 
+    bench = commands.add_parser("bench", help="run the benchmarks and print their medians")
+    bench.add_argument("--json", action="store_true", help="print one JSON object")
+    bench.add_argument(
+        "--only",
+        action="append",
+        choices=["world", "vehicle"],
+        help="run only this group (repeatable)",
+    )
+
     run = commands.add_parser("run", help="run a mission (for now: the scenario's world summary)")
     run.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
     return parser
@@ -56,6 +65,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _world(args)
     if args.command == "run":
         return _run(args)
+    if args.command == "bench":
+        return _bench(args)
     raise AssertionError(args.command)
 
 
@@ -85,6 +96,17 @@ def _run(args) -> int:
     world = World.load(args.scenario)
     print(summary_text(world))
     print("\nThe mission runner (vehicles + ground station) is not built yet; see issue 6.")
+    return 0
+
+
+def _bench(args) -> int:
+    from mission.bench import format_table, run_benchmarks
+
+    results = run_benchmarks(args.only)
+    if args.json:
+        print(json.dumps({r.name: r.value for r in results}))
+    else:
+        print(format_table(results))
     return 0
 
 

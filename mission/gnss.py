@@ -112,20 +112,25 @@ class GnssModel:
     ) -> GnssFix:
         """One fix at true position ``point``: truth + N(0, Sigma_GNSS) + multipath offset."""
         point = np.asarray(point, dtype=float).reshape(3)
-        geometry = self.geometry(point[None])
-        n_visible = int(geometry.n_visible[0])
-        if not geometry.has_fix[0]:
+        visible = self.visibility(point[None])[0]
+        n_visible = int(visible.sum())
+        cov_geom = _single_point_cov_geom(
+            self._rows[visible], self.sky.constellation_index()[visible]
+        )
+        factor = _cholesky_or_none(cov_geom) if cov_geom is not None else None
+        if cov_geom is None or factor is None:
             return GnssFix(False, None, None, n_visible, None, None)
-        covariance = self.settings.sigma_uere_m**2 * geometry.cov_geom[0]
-        noise = np.linalg.cholesky(covariance) @ rng.standard_normal(3)
+        covariance = self.settings.sigma_uere_m**2 * cov_geom
+        noise = self.settings.sigma_uere_m * (factor @ rng.standard_normal(3))
         offset = np.zeros(3) if offset_m is None else np.asarray(offset_m, dtype=float)
+        hdop = float(np.sqrt(cov_geom[0, 0] + cov_geom[1, 1]))
         return GnssFix(
             True,
             point + noise + offset,
             covariance,
             n_visible,
-            float(geometry.hdop[0]),
-            float(geometry.vdop[0]),
+            hdop,
+            float(np.sqrt(cov_geom[2, 2])),
         )
 
 
@@ -167,3 +172,27 @@ def _covariance_from_visibility(
     if np.any(has_fix):
         cov[has_fix] = np.linalg.inv(normal[has_fix])[:, :3, :3]
     return has_fix, cov
+
+
+def _single_point_cov_geom(rows: np.ndarray, system: np.ndarray) -> np.ndarray | None:
+    """cov_geom from the visible satellites' rows at one point, or None without a fix.
+
+    Same rule as the batched path: only the clocks of constellations in view are unknowns.
+    """
+    used = np.unique(system)
+    h = np.hstack((rows[:, :3], rows[:, 3 + used]))
+    if len(h) < h.shape[1]:
+        return None
+    normal = h.T @ h
+    if np.linalg.eigvalsh(normal)[0] <= _MIN_EIGENVALUE:  # the batched path's rule
+        return None
+    return np.linalg.inv(normal)[:3, :3]
+
+
+def _cholesky_or_none(matrix: np.ndarray) -> np.ndarray | None:
+    """Lower Cholesky factor, or None when the matrix is not positive definite (no fix)."""
+    try:
+        factor = np.linalg.cholesky(matrix)
+    except np.linalg.LinAlgError:
+        return None
+    return factor if np.all(np.isfinite(factor)) else None

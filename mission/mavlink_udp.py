@@ -14,6 +14,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 Address = tuple[str, int]
 MAX_DATAGRAM = 65_535
+MAX_BATCH_BYTES = 1_400  # stay below a typical path MTU
 
 
 @dataclass
@@ -136,6 +137,30 @@ class UdpEndpoint:
             except OSError:
                 self.counters.send_errors += 1
         return packet
+
+    def send_many(self, messages: list[Any], destinations: list[Address]) -> None:
+        """Encode several messages and send them packed into as few datagrams as fit.
+
+        MAVLink over UDP is a byte stream cut into datagrams: receivers (pymavlink, MAVProxy,
+        QGroundControl, this project) parse every packet in a datagram.
+        """
+        datagrams: list[bytes] = []
+        current = bytearray()
+        for message in messages:
+            packet = self.codec.encode(message)
+            if current and len(current) + len(packet) > MAX_BATCH_BYTES:
+                datagrams.append(bytes(current))
+                current = bytearray()
+            current += packet
+        if current:
+            datagrams.append(bytes(current))
+        for destination in destinations:
+            for datagram in datagrams:
+                try:
+                    self.sock.sendto(datagram, destination)
+                except OSError:
+                    self.counters.send_errors += 1
+            self.counters.packets_out += len(messages)
 
     def close(self) -> None:
         """Close the socket."""

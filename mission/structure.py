@@ -8,6 +8,7 @@ import numpy as np
 import trimesh
 
 from mission.errors import ScenarioError
+from mission.rays import best_ray_engine
 from mission.settings import BoxPrimitive, StructureSettings
 
 _EPS = 1e-6
@@ -26,6 +27,7 @@ class Structure:
         """``mesh`` is everything that occludes; ``boxes`` and a watertight ``solid_file_mesh``
         answer inside/outside queries."""
         self.mesh = mesh
+        self.rays = best_ray_engine(mesh)
         self.boxes = boxes
         self._box_min = np.array([b.min_m for b in boxes]).reshape(-1, 3)
         self._box_max = np.array([b.max_m for b in boxes]).reshape(-1, 3)
@@ -34,7 +36,7 @@ class Structure:
     @property
     def uses_embree(self) -> bool:
         """True when ray queries go through Embree."""
-        return type(self.mesh.ray).__module__.endswith("ray_pyembree")
+        return self.rays.name == "Embree"
 
     def rays_blocked(self, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """For each ray (origin, unit direction), True if it hits the structure anywhere."""
@@ -42,29 +44,26 @@ class Structure:
         directions = np.asarray(directions, dtype=float).reshape(-1, 3)
         if len(origins) == 0:
             return np.zeros(0, dtype=bool)
-        return np.asarray(self.mesh.ray.intersects_any(origins, directions), dtype=bool)
+        return self.rays.occluded(origins, directions)
 
     def segments_blocked(self, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        """For each segment start -> end, True if the structure lies between the two points."""
+        """For each segment start -> end, True if the structure lies between the two points.
+
+        The first hit along each ray decides; a point inside a closed solid sees its boundary
+        first, so segments into or out of the structure count as blocked.
+        """
         starts = np.atleast_2d(np.asarray(starts, dtype=float))
         ends = np.atleast_2d(np.asarray(ends, dtype=float))
         starts, ends = np.broadcast_arrays(starts, ends)
         delta = ends - starts
-        length = np.linalg.norm(delta, axis=1)
+        length = np.sqrt(np.einsum("ij,ij->i", delta, delta))
         blocked = np.zeros(len(starts), dtype=bool)
-        live = length > _EPS
-        if not np.any(live):
+        live = np.flatnonzero(length > _EPS)
+        if len(live) == 0:
             return blocked
-        index = np.flatnonzero(live)
         directions = delta[live] / length[live, None]
-        _, ray_ids, locations = self.mesh.ray.intersects_id(
-            starts[live], directions, multiple_hits=True, return_locations=True
-        )
-        if len(ray_ids):
-            hit_distance = np.linalg.norm(locations - starts[live][ray_ids], axis=1)
-            before_end = hit_distance < length[live][ray_ids] - _EPS
-            blocked[index[ray_ids[before_end]]] = True
-        return blocked | self.contains(starts) | self.contains(ends)
+        blocked[live] = self.rays.occluded(starts[live], directions, length[live] - _EPS)
+        return blocked
 
     def contains(self, points: np.ndarray) -> np.ndarray:
         """True for points inside a solid of the structure (boxes, or a watertight mesh file)."""

@@ -87,3 +87,15 @@ def test_observability_range_and_line_of_sight(along_world):
     hidden = camera.observe(above_deck, under_deck, rng)
     assert seen.valid and np.linalg.norm(seen.relative_m - (under_deck - beside)) < 1.0
     assert not hidden.valid and hidden.relative_m is None
+
+
+def test_observe_samples_have_sigma_r_covariance(along_world):
+    """The per-step scalar path draws from the same N(z, Sigma_r(z)) as sample()."""
+    camera = along_world.camera
+    rng = np.random.default_rng(9)
+    observer, target = np.array([2.0, -12.0, 6.0]), np.array([-1.0, -3.0, 5.0])
+    z = target - observer
+    samples = np.array([camera.observe(observer, target, rng).relative_m for _ in range(8000)])
+    whitened = np.linalg.solve(np.linalg.cholesky(camera.covariance(z)), (samples - z).T).T
+    np.testing.assert_allclose(whitened.mean(axis=0), 0.0, atol=0.05)
+    np.testing.assert_allclose(np.cov(whitened.T), np.eye(3), atol=0.06)

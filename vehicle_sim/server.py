@@ -32,6 +32,7 @@ from vehicle_sim.vehicle import Vehicle
 PEER_EXPIRY_WALL_S = 30.0
 MAX_WAIT_WALL_S = 0.1
 IDLE_HEARTBEAT_WALL_S = 1.0
+MAX_TICK_JUMP_S = 60.0  # a clock tick may advance at most this far (guards against garbage)
 
 
 @dataclass(frozen=True)
@@ -80,14 +81,31 @@ class VehicleServer:
         self._last_idle_heartbeat = -math.inf
         self._pending_deadline: float | None = None
         self._parent = os.getppid()
+        self._batch: list[Any] | None = None
 
     def attach(self, vehicle: Vehicle) -> None:
         """Connect the vehicle whose messages this server carries."""
         self.vehicle = vehicle
 
     def broadcast(self, message: Any) -> None:
-        """Send a message to every peer that has talked to us and every --out address."""
-        self.endpoint.send(message, [*self.peers, *self.outs])
+        """Send a message to every peer that has talked to us and every --out address.
+
+        While a step is being published, messages are collected and leave together.
+        """
+        if self._batch is not None:
+            self._batch.append(message)
+        else:
+            self.endpoint.send(message, [*self.peers, *self.outs])
+
+    def _publish_step(self, truth: Any) -> None:
+        """Publish the step's telemetry as one batch of datagrams."""
+        assert self.vehicle is not None
+        self._batch = []
+        try:
+            self.vehicle.publish(truth)
+        finally:
+            batch, self._batch = self._batch, None
+            self.endpoint.send_many(batch, [*self.peers, *self.outs])
 
     # -- main loop --------------------------------------------------------------------------
     def run(self) -> None:
@@ -140,15 +158,25 @@ class VehicleServer:
         self.peers[sender] = now
         self.stats.peers_seen.add(sender)
         if message.get_type() == "SYSTEM_TIME":
-            if self.clock.lockstep and 0 < message.time_boot_ms < 2**32 - 1:
-                self._requested_s = max(self._requested_s, message.time_boot_ms / 1000.0)
-                self._started = True
-                self._last_tick_wall = now
+            if self.clock.lockstep:
+                self._on_tick(message.time_boot_ms / 1000.0, now)
             return
         try:
             vehicle.handle(message, now)
         except Exception as error:  # a malformed message never kills the vehicle
             vehicle.counters.reject(f"handler error {type(error).__name__}")
+
+    def _on_tick(self, time_s: float, now: float) -> None:
+        """The ground station's clock: advance to ``time_s`` (bounded jumps only)."""
+        vehicle = self.vehicle
+        assert vehicle is not None
+        if not 0 < time_s - vehicle.sim_time_s <= MAX_TICK_JUMP_S:
+            if time_s > vehicle.sim_time_s:
+                vehicle.counters.reject("clock tick too far ahead")
+            return
+        self._requested_s = max(self._requested_s, time_s)
+        self._started = True
+        self._last_tick_wall = now
 
     # -- stepping ---------------------------------------------------------------------------
     def _advance(self, now: float) -> None:
@@ -182,7 +210,7 @@ class VehicleServer:
         if self.truth_sender is not None:
             self.truth_sender.publish(vehicle.kinematics.truth, vehicle.time_boot_ms)
         if self.truth_receiver is None or not vehicle.sensor_due():
-            vehicle.publish(None)
+            self._publish_step(None)
             return True
         self.truth_receiver.drain()
         truth = self.truth_receiver.exact(vehicle.time_boot_ms)
@@ -190,7 +218,7 @@ class VehicleServer:
             timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
             self._pending_deadline = now + timeout
             return False
-        vehicle.publish(
+        self._publish_step(
             truth if truth is not None else self.truth_receiver.estimate(vehicle.time_boot_ms)
         )
         return True
@@ -205,7 +233,7 @@ class VehicleServer:
             self.stats.truth_waits_timed_out += 1
             truth = receiver.estimate(vehicle.time_boot_ms)
         self._pending_deadline = None
-        vehicle.publish(truth)
+        self._publish_step(truth)
         return True
 
     def _idle_heartbeat(self, now: float) -> None:

@@ -76,6 +76,8 @@ class Vehicle:
         self.counters = LinkCounters()
         self.failsafe = False
         self._last_setpoint_s = 0.0
+        self._last_warning = ""
+        self._last_warning_s = -math.inf
         vs = scenario.vehicle
         self.step_s = scenario.control.t_cont_s
         self.speed_limit_m_s = (
@@ -289,8 +291,9 @@ class Vehicle:
     def _on_setpoint(self, msg: Any) -> None:
         problem = self._setpoint_problem(msg)
         if problem is not None:
-            self.counters.reject(f"setpoint {problem}")
-            self.notify(mavlink2.MAV_SEVERITY_WARNING, f"Setpoint rejected: {problem}")
+            category, detail = problem
+            self.counters.reject(f"setpoint: {category}")
+            self._warn_once(f"Setpoint rejected: {detail}")
             return
         self.kinematics.target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
         self._last_setpoint_s = self.sim_time_s
@@ -298,19 +301,26 @@ class Vehicle:
             self.failsafe = False
             self.notify(mavlink2.MAV_SEVERITY_NOTICE, "Failsafe cleared: setpoints resumed")
 
-    def _setpoint_problem(self, msg: Any) -> str | None:
+    def _setpoint_problem(self, msg: Any) -> tuple[str, str] | None:
+        """(category, detail) of what is wrong with a setpoint, or None."""
         if msg.coordinate_frame != mavlink2.MAV_FRAME_LOCAL_NED:
-            return f"frame {msg.coordinate_frame} (LOCAL_NED only)"
+            return "frame", f"frame {msg.coordinate_frame}, LOCAL_NED only"
         mask = int(msg.type_mask)
         ignores_motion = (mask & POSITION_ONLY_MASK_REQUIRED) == POSITION_ONLY_MASK_REQUIRED
         if mask & POSITION_BITS or not ignores_motion or mask & FORCE_BIT:
-            return f"type_mask {mask} (position targets only)"
+            return "type_mask", f"type_mask {mask}, position targets only"
         values = (msg.x, msg.y, msg.z)
         if not all(math.isfinite(v) and abs(v) < MAX_ABS_COORD_M for v in values):
-            return "position out of range"
+            return "out of range", "position out of range"
         if not self.armed or self.mode != modes.GUIDED:
-            return "not armed in GUIDED"
+            return "not guided", "not armed in GUIDED"
         return None
+
+    def _warn_once(self, text: str) -> None:
+        """A warning STATUSTEXT, not repeated while the same problem persists (5 s)."""
+        if text != self._last_warning or self.sim_time_s - self._last_warning_s >= 5.0:
+            self.notify(mavlink2.MAV_SEVERITY_WARNING, text)
+            self._last_warning, self._last_warning_s = text, self.sim_time_s
 
     def _on_vision_estimate(self, msg: Any) -> None:
         values = (msg.x, msg.y, msg.z)

@@ -1,0 +1,173 @@
+"""``python -m mission bench``: every benchmark of the project, as a table or one JSON object.
+
+Benchmarks measure medians over repeats on this machine; targets are the issues' figures.
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from mission.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
+
+
+@dataclass(frozen=True)
+class BenchResult:
+    """One measured figure and its target."""
+
+    name: str
+    value: float
+    unit: str
+    target: str
+    ok: bool
+
+
+def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
+    """Time to build the sigma_0 map of the default workspace (40,000 voxels x 15 satellites)."""
+    from mission.world import World
+
+    world = World.load("along")
+    times = [world.sigma0_map().build_s for _ in range(repeats)]
+    median = statistics.median(times)
+    return [BenchResult("sigma0_map_build_s", median, "s", "<= 3", median <= 3.0)]
+
+
+def bench_vehicle(steps: int = 1000, repeats: int = 3, pings: int = 500) -> list[BenchResult]:
+    """Lockstep steps per second of one vehicle under a minimal driver; COMMAND_LONG round trip."""
+    process, address = _start_vehicle()
+    try:
+        endpoint = UdpEndpoint(MavlinkCodec(255, 190))
+        queue = MessageQueue(endpoint)
+        steps_per_s = statistics.median(
+            _drive_lockstep(endpoint, address, steps, first=1 + r * steps) for r in range(repeats)
+        )
+        rtts = []
+        command = mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL
+        for _ in range(pings):
+            sent = time.perf_counter()
+            endpoint.send(
+                mavlink2.MAVLink_command_long_message(
+                    2, 1, command, 0, mavlink2.MAVLINK_MSG_ID_HEARTBEAT, 0, 0, 0, 0, 0, 0
+                ),
+                [address],
+            )
+            _wait(queue, lambda m: m.get_type() == "COMMAND_ACK" and m.command == command)
+            rtts.append((time.perf_counter() - sent) * 1000)
+        endpoint.close()
+    finally:
+        process.terminate()
+        process.wait(timeout=10)
+    rtt = statistics.median(rtts)
+    return [
+        BenchResult("vehicle_steps_per_s", steps_per_s, "steps/s", ">= 2000", steps_per_s >= 2000),
+        BenchResult("mavlink_rtt_ms_median", rtt, "ms", "< 1", rtt < 1.0),
+    ]
+
+
+def _drive_lockstep(
+    endpoint: UdpEndpoint, address: tuple[str, int], steps: int, first: int = 1
+) -> float:
+    """Tick the vehicle ``steps`` times as a minimal driver would: raw datagrams, no decoding
+    except spotting the SYSTEM_TIME step marker by its message id in the packet headers."""
+    codec = endpoint.codec
+    ticks = [
+        codec.encode(mavlink2.MAVLink_system_time_message(0, 500 * k))
+        for k in range(first, first + steps)
+    ]
+    marker = mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME.to_bytes(3, "little")
+    sock = endpoint.sock
+    sock.setblocking(True)
+    sock.settimeout(5.0)
+    start = time.perf_counter()
+    deadline = start + 60.0
+    for tick in ticks:
+        sock.sendto(tick, address)
+        while True:
+            datagram = sock.recv(65535)
+            if _has_message(datagram, marker):
+                break
+            if time.perf_counter() > deadline:
+                raise RuntimeError("the vehicle stopped answering clock ticks")
+    elapsed = time.perf_counter() - start
+    sock.setblocking(False)
+    return steps / elapsed
+
+
+def _has_message(datagram: bytes, message_id: bytes) -> bool:
+    """Whether a datagram of MAVLink 2 packets holds one with this id (headers only)."""
+    offset = 0
+    while offset + 10 <= len(datagram) and datagram[offset] == 0xFD:
+        if datagram[offset + 7 : offset + 10] == message_id:
+            return True
+        signed = datagram[offset + 2] & 0x01
+        offset += 12 + datagram[offset + 1] + (13 if signed else 0)
+    return False
+
+
+def _start_vehicle() -> tuple[subprocess.Popen, tuple[str, int]]:
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "vehicle_sim",
+            "--vehicle",
+            "support-1",
+            "--port",
+            "0",
+            "--home",
+            "0",
+            "-10",
+            "7",
+            "--exit-with-parent",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert process.stderr is not None
+    line = process.stderr.readline()
+    if "listening on" not in line:
+        process.kill()
+        raise RuntimeError(f"vehicle did not start: {line.strip()}")
+    host_port = line.split("listening on ")[1].split(",")[0]
+    host, port = host_port.rsplit(":", 1)
+    return process, (host, int(port))
+
+
+def _wait(queue: MessageQueue, match: Callable, timeout_s: float = 5.0) -> None:
+    deadline = time.perf_counter() + timeout_s
+    while (got := queue.next(deadline - time.perf_counter())) is not None:
+        if match(got[0]):
+            return
+    raise RuntimeError("benchmark peer stopped answering")
+
+
+BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
+    "world": bench_sigma0_map,
+    "vehicle": bench_vehicle,
+}
+
+
+def run_benchmarks(only: list[str] | None = None) -> list[BenchResult]:
+    """Run the chosen benchmark groups (all by default)."""
+    results: list[BenchResult] = []
+    for name, bench in BENCHMARKS.items():
+        if only is None or name in only:
+            results.extend(bench())
+    return results
+
+
+def format_table(results: list[BenchResult]) -> str:
+    """A plain-text table of results."""
+    lines = [f"{'benchmark':<32} {'value':>12} {'unit':<8} {'target':<10} ok"]
+    lines += [
+        f"{r.name:<32} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {'yes' if r.ok else 'NO'}"
+        for r in results
+    ]
+    return "\n".join(lines)

@@ -1,0 +1,81 @@
+"""MAVProxy, a real ground station from PyPI, loads and lists a mission on our vehicle."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ground_station.mission_client import MissionClient, MissionTransferError
+from mission.frames import GeodeticFrame
+from mission.waypoints import (
+    WaypointRow,
+    format_waypoints,
+    read_waypoints,
+    waypoint_rows_from_enu,
+    write_waypoints,
+)
+from tests.mav_client import MavClient
+from tests.processes import stop_process, vehicle_process
+
+
+def _mavproxy(port: int, command: str, cwd: Path) -> tuple[subprocess.Popen, list[str]]:
+    executable = shutil.which("mavproxy.py") or str(Path(sys.executable).parent / "mavproxy.py")
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            executable,
+            f"--master=udpout:127.0.0.1:{port}",
+            "--target-system=2",
+            "--non-interactive",
+            "--no-state",
+            "--default-modules=wp",
+            f"--cmd={command}",
+        ],
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        cwd=cwd,
+    )
+    lines: list[str] = []
+    assert process.stdout is not None
+    threading.Thread(target=lambda: lines.extend(process.stdout), daemon=True).start()
+    return process, lines
+
+
+def test_mavproxy_loads_and_lists_a_waypoint_file(along, tmp_path):
+    points = np.array([[0.0, -10.0, 7.0], [3.0, -10.0, 7.0], [6.0, -11.0, 8.0]])
+    path = tmp_path / "support-1.waypoints"
+    write_waypoints(path, waypoint_rows_from_enu(points, GeodeticFrame(along.world.anchor), 0.1))
+    with vehicle_process("support-1", "--speedup", "1") as vehicle:
+        loader, _ = _mavproxy(vehicle.port, f"wp load {path}", tmp_path)
+        client = MavClient(vehicle.address)
+        mission = MissionClient(client.queue, vehicle.address, 2, timeout_s=0.5, retries=1)
+        rows: list[WaypointRow] = []
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and len(rows) != 4:
+            time.sleep(0.5)
+            try:
+                rows = [WaypointRow.from_item(item) for item in mission.download()]
+            except MissionTransferError:
+                continue
+        stop_process(loader)
+        client.close()
+        assert format_waypoints(rows) == path.read_text(), "the vehicle holds the file's mission"
+
+        lister, lines = _mavproxy(vehicle.port, "wp list", tmp_path)
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and sum(line.startswith("16 3 ") for line in lines) < 4:
+            time.sleep(0.2)
+        stop_process(lister)
+    listed = [line.split() for line in lines if line.startswith("16 3 ")]
+    assert len(listed) == 4
+    for fields, row in zip(listed, read_waypoints(path)):
+        assert float(fields[2]) == row.x and float(fields[3]) == row.y
+        assert float(fields[4]) == row.z

@@ -1,0 +1,42 @@
+"""The Embree occlusion engine agrees with trimesh's own ray tracer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mission.rays import EmbreeRays, TrimeshRays, rtcore_scene
+
+
+@pytest.mark.skipif(rtcore_scene is None, reason="embreex has no wheel for this machine")
+def test_embree_and_trimesh_agree_on_rays_and_segments(along_world):
+    mesh = along_world.structure.mesh
+    embree, reference = EmbreeRays(mesh), TrimeshRays(mesh)
+    rng = np.random.default_rng(4)
+    origins = rng.uniform([-25, -12, 0.5], [25, 12, 15], (3000, 3))
+    directions = rng.normal(size=(3000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    lengths = rng.uniform(0.5, 30, 3000)
+    rays_embree = embree.occluded(origins, directions)
+    assert 0.1 < rays_embree.mean() < 0.9, "a mix of hits and misses"
+    np.testing.assert_array_equal(rays_embree, reference.occluded(origins, directions))
+    np.testing.assert_array_equal(
+        embree.occluded(origins, directions, lengths),
+        reference.occluded(origins, directions, lengths),
+    )
+
+
+def test_the_fallback_engine_gives_the_same_gnss_visibility(along_world):
+    """With trimesh's tracer the GNSS visibility is the same as with the default engine."""
+    from mission.structure import Structure
+
+    structure = along_world.structure
+    fallback = Structure(structure.mesh, structure.boxes)
+    fallback.rays = TrimeshRays(structure.mesh)
+    directions = along_world.sky.directions_enu
+    points = np.array([[0.0, -7.0, 7.0], [0.0, 0.0, 6.0], [10.0, -6.0, 3.0]])
+    origins = np.repeat(points, len(directions), axis=0)
+    tiled = np.tile(directions, (len(points), 1))
+    np.testing.assert_array_equal(
+        structure.rays_blocked(origins, tiled), fallback.rays_blocked(origins, tiled)
+    )

@@ -1,0 +1,114 @@
+"""10,000 random and mutated datagrams at a vehicle: it survives and still does its job."""
+
+from __future__ import annotations
+
+import math
+import socket
+import time
+
+import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from ground_station.mission_client import MissionClient
+from mission.mavlink_udp import MavlinkCodec
+from mission.mission_items import MissionItem
+from tests.mav_client import MavClient
+from tests.processes import vehicle_process
+
+HOSTILE_FLOATS = [math.nan, math.inf, -math.inf, 1e38, -1e38, 0.0, 1e-38, 12.5]
+
+
+def _hostile_messages(rng: np.random.Generator, count: int) -> list:
+    """Well-formed packets (valid CRC) whose contents are nonsense."""
+    f = lambda: float(rng.choice(HOSTILE_FLOATS))  # noqa: E731
+    u = lambda bits: int(rng.integers(0, 2**bits, dtype=np.uint64))  # noqa: E731
+    makers = [
+        lambda: mavlink2.MAVLink_set_position_target_local_ned_message(
+            u(32), 2, 1, u(8), u(16), f(), f(), f(), f(), f(), f(), f(), f(), f(), f(), f()
+        ),
+        lambda: mavlink2.MAVLink_vision_position_estimate_message(
+            u(64), f(), f(), f(), f(), f(), f()
+        ),
+        lambda: mavlink2.MAVLink_command_long_message(
+            2, 1, u(16), u(8), f(), f(), f(), f(), f(), f(), f()
+        ),
+        lambda: mavlink2.MAVLink_command_int_message(
+            2, 1, u(8), u(16), 0, 0, f(), f(), f(), f(), u(31), u(31), f()
+        ),
+        lambda: mavlink2.MAVLink_mission_count_message(2, 1, u(16), u(8)),
+        lambda: mavlink2.MAVLink_mission_item_int_message(
+            2,
+            1,
+            u(16),
+            u(8),
+            u(16),
+            u(8),
+            u(8),
+            f(),
+            f(),
+            f(),
+            f(),
+            u(31) - 2**30,
+            u(31) - 2**30,
+            f(),
+            u(8),
+        ),
+        lambda: mavlink2.MAVLink_mission_request_int_message(2, 1, u(16), u(8)),
+        lambda: mavlink2.MAVLink_mission_set_current_message(2, 1, u(16)),
+        lambda: mavlink2.MAVLink_set_mode_message(2, u(8), u(32)),
+        lambda: mavlink2.MAVLink_system_time_message(u(64), u(32)),
+        lambda: mavlink2.MAVLink_timesync_message(u(63), u(63)),
+    ]
+    return [makers[int(rng.integers(len(makers)))]() for _ in range(count)]
+
+
+def _datagrams(seed: int = 1) -> list[bytes]:
+    rng = np.random.default_rng(seed)
+    codec = MavlinkCodec(255, 190)
+    valid = [codec.encode(m) for m in _hostile_messages(rng, 3000)]
+    random_bytes = [rng.bytes(int(rng.integers(1, 300))) for _ in range(3000)]
+    mutated = []
+    for _ in range(4000):
+        packet = bytearray(valid[int(rng.integers(len(valid)))])
+        kind = int(rng.integers(4))
+        if kind == 0:
+            for _ in range(int(rng.integers(1, 4))):
+                packet[int(rng.integers(len(packet)))] ^= int(rng.integers(1, 256))
+        elif kind == 1:
+            packet = packet[: int(rng.integers(1, len(packet)))]
+        elif kind == 2:
+            packet = bytearray(rng.bytes(int(rng.integers(1, 20)))) + packet
+        else:
+            packet[0] = 0xFE  # MAVLink 1 marker on a MAVLink 2 body
+        mutated.append(bytes(packet))
+    datagrams = valid + random_bytes + mutated
+    rng.shuffle(datagrams)
+    return datagrams
+
+
+def test_vehicle_survives_fuzzing_and_still_takes_a_mission():
+    datagrams = _datagrams()
+    assert len(datagrams) >= 10_000
+    with vehicle_process("support-1") as vehicle:  # lockstep: fuzzed clock ticks included
+        fuzzer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        for i, datagram in enumerate(datagrams):
+            fuzzer.sendto(datagram, vehicle.address)
+            if i % 200 == 199:
+                time.sleep(0.005)
+        fuzzer.close()
+        time.sleep(0.5)
+        assert vehicle.process.poll() is None, "the vehicle died"
+        client = MavClient(vehicle.address)
+        items = [
+            MissionItem(i, 3, 16, 0, 1, 0.0, 0.1, 0.0, 0.0, 351500000 + i, 1369600000, 7.0)
+            for i in range(6)
+        ]
+        mission = MissionClient(client.queue, vehicle.address, 2, timeout_s=2.0)
+        assert mission.upload(items) == mavlink2.MAV_MISSION_ACCEPTED
+        assert [i.x for i in mission.download()] == [i.x for i in items]
+        client.close()
+        summary = vehicle.stop()
+    assert vehicle.process.returncode == 0
+    bad = int(summary.split("bad ")[1].split(" datagrams")[0])
+    assert bad >= 3000, summary
+    assert "Traceback" not in summary
