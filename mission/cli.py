@@ -44,6 +44,16 @@ def build_parser() -> OneLineArgumentParser:
         help="draw structure, zones, sky plot and sigma_0 slices",
     )
 
+    plan = commands.add_parser("plan", help="plan the support UAVs' paths; write waypoint files")
+    plan.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
+    plan.add_argument(
+        "--out",
+        type=Path,
+        metavar="DIR",
+        help="directory for the files (default: the scenario's waypoints_dir)",
+    )
+    plan.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the plan")
+
     bench = commands.add_parser("bench", help="run the benchmarks and print their medians")
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument(
@@ -67,6 +77,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _run(args)
     if args.command == "bench":
         return _bench(args)
+    if args.command == "plan":
+        return _plan(args)
     raise AssertionError(args.command)
 
 
@@ -96,6 +108,35 @@ def _run(args) -> int:
     world = World.load(args.scenario)
     print(summary_text(world))
     print("\nThe mission runner (vehicles + ground station) is not built yet; see issue 6.")
+    return 0
+
+
+def _plan(args) -> int:
+    from mission.plan_files import write_plan
+    from mission.planner import plan_supports
+    from mission.zone_placement import place_along, place_wall
+
+    if args.plot is not None:
+        _check_output_path(args.plot, "--plot", ".png")
+    world = World.load(args.scenario)
+    plan = plan_supports(world)
+    out = args.out if args.out is not None else Path(world.scenario.task.waypoints_dir)
+    for path in write_plan(plan, world.scenario, out):
+        print(f"wrote {path}")
+    along, segment = place_along(plan, world.workspace)
+    wall = place_wall(plan, world.workspace)
+    print(
+        f"an Along zone for this plan (segment w_1,{segment + 1} -> w_1,{segment + 2}): "
+        f"min_m {list(along.min_m)}, max_m {list(along.max_m)}"
+    )
+    print(
+        f"a Wall zone for this plan (around w_1,6): min_m {list(wall.min_m)}, "
+        f"max_m {list(wall.max_m)}"
+    )
+    if args.plot is not None:
+        from mission.plan_plot import plot_plan
+
+        plot_plan(world, plan, args.plot)
     return 0
 
 

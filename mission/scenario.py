@@ -124,6 +124,9 @@ def _absolutise_paths(data: dict[str, Any], directory: Path) -> None:
     structure = _get(data, "world", "structure")
     if isinstance(structure, dict) and isinstance(structure.get("mesh_file"), str):
         structure["mesh_file"] = str((directory / structure["mesh_file"]).resolve())
+    task = data.get("task")
+    if isinstance(task, dict) and isinstance(task.get("waypoints_dir"), str):
+        task["waypoints_dir"] = str((directory / task["waypoints_dir"]).resolve())
     sky = data.get("sky")
     if isinstance(sky, dict) and isinstance(sky.get("table"), str) and sky["table"] != "builtin":
         sky["table"] = str((directory / sky["table"]).resolve())

@@ -294,12 +294,42 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class TaskSettings:
-    """The task: how many support UAVs accompany the work UAV."""
+    """The task: the work UAV's inspection waypoints and the support UAVs accompanying it.
+
+    ``waypoints_dir`` holds the planned QGC WPL 110 files (``work.waypoints``,
+    ``support-N.waypoints``), relative to the scenario file that names it.
+    """
 
     supports: int
+    work_waypoints_m: list[Vec3]
+    waypoints_dir: str
 
     def __post_init__(self) -> None:
         _require(1 <= self.supports <= 50, "supports", f"must be in 1..50, got {self.supports}")
+        _require(len(self.work_waypoints_m) >= 2, "work_waypoints_m", "needs at least 2 points")
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """The offline planner of the support UAVs' paths (MODEL.md 3.3; the paper's ref. [18])."""
+
+    lattice_m: float
+    w_gnss_per_m2: float
+    w_relative_per_m2: float
+    w_move_per_m: float
+    w_spread: float
+    min_separation_m: float
+    clearance_m: float
+    min_altitude_m: float
+    max_range_fraction: float
+    rounds: int
+
+    def __post_init__(self) -> None:
+        _positive(self, "lattice_m", "max_range_fraction")
+        _non_negative(self, "w_gnss_per_m2", "w_relative_per_m2", "w_move_per_m", "w_spread")
+        _non_negative(self, "min_separation_m", "clearance_m", "min_altitude_m")
+        _require(self.max_range_fraction <= 1, "max_range_fraction", "must be at most 1")
+        _require(self.rounds >= 1, "rounds", "must be at least 1")
 
 
 @dataclass(frozen=True)
@@ -345,4 +375,11 @@ class Scenario:
     control: ControlSettings
     run: RunSettings
     task: TaskSettings
+    planner: PlannerSettings
     vehicle: VehicleSettings
+
+    def __post_init__(self) -> None:
+        for i, point in enumerate(self.task.work_waypoints_m):
+            box = self.world.workspace
+            inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))
+            _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")

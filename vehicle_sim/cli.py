@@ -10,6 +10,7 @@ import numpy as np
 from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
 from mission.errors import InputError
 from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
+from mission.plan_files import read_vehicle_waypoints
 from mission.world import World
 from vehicle_sim.identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
 from vehicle_sim.server import ClockSettings, VehicleServer, install_signal_handlers
@@ -77,7 +78,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     outs = [_address(text, "--out") for text in args.out]
     world = World.load(args.scenario)
     scenario = world.scenario
-    home = np.array(parse_point(args.home, "--home")) if args.home else _planned_home(identity)
+    if args.home:
+        home = np.array(parse_point(args.home, "--home"))
+    else:
+        home = read_vehicle_waypoints(scenario, identity.name)[0]
     clock = ClockSettings(lockstep=args.speedup is None, speedup=args.speedup or 1.0)
 
     truth_sender = truth_receiver = None
@@ -145,12 +149,6 @@ def _check_port(port: int, flag: str, allow_any: bool = False) -> None:
     lowest = 0 if allow_any else 1
     if not lowest <= port < 65536:
         raise InputError("command line", flag, f"port must be in {lowest}..65535, got {port}")
-
-
-def _planned_home(identity: VehicleIdentity) -> np.ndarray:
-    raise InputError(
-        "command line", "--home", f"no planned waypoints for {identity.name} yet: give --home X Y Z"
-    )
 
 
 def entry_point(argv: Sequence[str] | None = None) -> int:

@@ -1,0 +1,84 @@
+"""Top and side views of a plan: bridge, zones, sigma_0, work and support paths (Figs. 4-5)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.collections import PolyCollection
+from matplotlib.patches import Rectangle
+
+from mission.atomic import write_atomically
+from mission.planner import Plan
+from mission.world import World
+
+COLORS = ("tab:blue", "tab:green", "tab:purple", "tab:olive", "tab:cyan")
+
+
+def plot_plan(world: World, plan: Plan, path: Path) -> None:
+    """Write a two-panel PNG of the plan."""
+    sigma0 = world.sigma0_map()
+    fig, axes = plt.subplots(2, 1, figsize=(12, 11))
+    for ax, (a, b, normal, title) in zip(axes, ((0, 1, 2, "top view"), (0, 2, 1, "side view"))):
+        level = float(np.mean(plan.supports[:, :, normal]))
+        k = int(sigma0.grid.index_of(np.full((1, 3), level))[0, normal])
+        values = np.take(sigma0.sigma_m, k, axis=normal)
+        lo = sigma0.grid.origin_m
+        hi = lo + sigma0.grid.voxel_m * np.array(sigma0.grid.shape)
+        image = ax.imshow(
+            values.T,
+            origin="lower",
+            extent=(lo[a], hi[a], lo[b], hi[b]),
+            cmap="RdYlGn_r",
+            interpolation="nearest",
+            alpha=0.6,
+            norm=matplotlib.colors.LogNorm(0.1, world.scenario.map.no_fix_sigma_m),
+        )
+        plt.colorbar(image, ax=ax, label="sigma_0 [m]", shrink=0.8)
+        triangles = world.structure.mesh.triangles[:, :, [a, b]]
+        ax.add_collection(PolyCollection(triangles, facecolor="0.5", edgecolor="none", alpha=0.2))
+        for zone in world.scenario.world.zones:
+            ax.add_patch(
+                Rectangle(
+                    (zone.min_m[a], zone.min_m[b]),
+                    zone.max_m[a] - zone.min_m[a],
+                    zone.max_m[b] - zone.min_m[b],
+                    fill=False,
+                    edgecolor="magenta",
+                    linewidth=2,
+                    label=f"zone {zone.name}",
+                )
+            )
+        _path(ax, plan.work, a, b, "tab:red", "work UAV")
+        for n, points in enumerate(plan.supports):
+            _path(ax, points, a, b, COLORS[n % len(COLORS)], f"support {n + 1}")
+        axis = "xyz"
+        ax.set_title(
+            f"{title}, sigma_0 at {axis[normal]} = {sigma0.grid.axis_centers(normal)[k]:g} m"
+        )
+        ax.set_xlabel(f"{axis[a]} [m]")
+        ax.set_ylabel(f"{axis[b]} [m]")
+        ax.set_aspect("equal")
+        ax.legend(loc="upper right", fontsize=7)
+    fig.suptitle(f"plan of scenario '{world.scenario.name}' (numbers: waypoint index)")
+    fig.tight_layout()
+    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=100, format="png"))
+    plt.close(fig)
+
+
+def _path(ax, points: np.ndarray, a: int, b: int, color: str, label: str) -> None:
+    ax.plot(points[:, a], points[:, b], "-o", color=color, markersize=4, label=label)
+    for i, point in enumerate(points, start=1):
+        ax.annotate(
+            str(i),
+            (point[a], point[b]),
+            fontsize=7,
+            color=color,
+            xytext=(3, 3),
+            textcoords="offset points",
+        )
