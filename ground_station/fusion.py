@@ -1,0 +1,150 @@
+"""Selective fusion for the work UAV (paper 3.2.1) and feedback to each support (3.2.2).
+
+Each support n with a fix p_n and a valid observation r_n gives the likelihood
+N(mu_n, Sigma_n), mu_n = p_n + r_n, Sigma_n = Sigma_GNSS(p_n) + Sigma_r(r_n). Supports whose
+likelihoods correlate (Pearson, over a broad particle set around the predicted position) with
+at least half of the contributing supports form the consistent set S; xhat is the candidate
+particle maximising sum_{n in S} log f(x; mu_n, Sigma_n). Interpretations: MODEL.md 3.2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.settings import FusionSettings
+
+
+@dataclass(frozen=True)
+class SupportMeasurement:
+    """What the ground station has from one support this cycle (ENU)."""
+
+    name: str
+    fix_m: np.ndarray | None
+    sigma_gnss_m2: np.ndarray | None
+    relative_m: np.ndarray | None
+    sigma_relative_m2: np.ndarray | None
+
+    @property
+    def contributes(self) -> bool:
+        """True with both a fix and a valid observation."""
+        return self.fix_m is not None and self.relative_m is not None
+
+    @property
+    def mu(self) -> np.ndarray:
+        """p_n + r_n."""
+        assert self.fix_m is not None and self.relative_m is not None
+        return self.fix_m + self.relative_m
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """Sigma_GNSS(p_n) + Sigma_r(r_n)."""
+        assert self.sigma_gnss_m2 is not None and self.sigma_relative_m2 is not None
+        return self.sigma_gnss_m2 + self.sigma_relative_m2
+
+
+@dataclass(frozen=True)
+class FusionResult:
+    """The outcome of one fusion: xhat (None when blind), S, and how it was reached."""
+
+    xhat: np.ndarray | None
+    consistent: tuple[str, ...]
+    contributing: tuple[str, ...]
+    fallback: bool
+    rho: np.ndarray
+    gaussians: tuple[tuple[np.ndarray, np.ndarray], ...]
+
+    @property
+    def blind(self) -> bool:
+        """No support contributed: no new estimate."""
+        return self.xhat is None
+
+    def log_p(self, x: np.ndarray) -> np.ndarray:
+        """log P(x) up to the constant alpha: sum over S of log f(x; mu_n, Sigma_n)."""
+        return sum(
+            (log_gaussian(np.atleast_2d(x), mu, sigma) for mu, sigma in self.gaussians),
+            start=np.zeros(len(np.atleast_2d(x))),
+        )
+
+
+def log_gaussian(x: np.ndarray, mu: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """log N(x; mu, sigma) for rows of x."""
+    factor = np.linalg.cholesky(sigma)
+    z = np.linalg.solve(factor, (x - mu).T)
+    log_det = 2.0 * np.sum(np.log(np.diag(factor)))
+    return -0.5 * (np.sum(z * z, axis=0) + log_det + 3 * np.log(2 * np.pi))
+
+
+def selective_fusion(
+    supports: list[SupportMeasurement],
+    predicted: np.ndarray,
+    settings: FusionSettings,
+    rng: np.random.Generator,
+) -> FusionResult:
+    """Estimate the work UAV's position from the consistent supports."""
+    contributing = [s for s in supports if s.contributes]
+    names = tuple(s.name for s in contributing)
+    if not contributing:
+        return FusionResult(None, (), (), False, np.zeros((0, 0)), ())
+    broad = predicted + settings.broad_sigma_m * rng.standard_normal((settings.broad_particles, 3))
+    local = [
+        rng.multivariate_normal(s.mu, s.sigma, settings.local_particles, method="cholesky")
+        for s in contributing
+    ]
+    rho = correlation_matrix([log_gaussian(broad, s.mu, s.sigma) for s in contributing])
+    agree = (rho > settings.rho_threshold).sum(axis=1)
+    chosen = [s for s, count in zip(contributing, agree) if count >= len(contributing) / 2]
+    fallback = not chosen
+    if fallback:
+        chosen = contributing
+    particles = np.vstack([broad, *local])
+    gaussians = tuple((s.mu, s.sigma) for s in chosen)
+    score = sum(log_gaussian(particles, mu, sigma) for mu, sigma in gaussians)
+    xhat = particles[int(np.argmax(score))]
+    return FusionResult(xhat, tuple(s.name for s in chosen), names, fallback, rho, gaussians)
+
+
+def correlation_matrix(log_densities: list[np.ndarray]) -> np.ndarray:
+    """Pearson correlation between density vectors given as logs (scale-free, no underflow).
+
+    A vector with no spread (every density zero in floating point) correlates with nothing.
+    """
+    n = len(log_densities)
+    values = np.array([np.exp(v - np.max(v)) for v in log_densities])
+    centred = values - values.mean(axis=1, keepdims=True)
+    norms = np.sqrt(np.sum(centred * centred, axis=1))
+    rho = np.eye(n)
+    for i in range(n):
+        for j in range(i + 1, n):
+            if norms[i] > 0 and norms[j] > 0:
+                rho[i, j] = rho[j, i] = float(centred[i] @ centred[j] / (norms[i] * norms[j]))
+            else:
+                rho[i, j] = rho[j, i] = 0.0
+    return rho
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """yhat_n and beta_n for one support (beta None when yhat came from a fallback rule)."""
+
+    yhat: np.ndarray
+    beta: float | None
+
+
+def support_feedback(
+    support: SupportMeasurement,
+    fusion: FusionResult,
+    previous_yhat: np.ndarray,
+    last_command: np.ndarray,
+) -> Feedback:
+    """Feed xhat back to a support's estimate (3.2.2) with MODEL.md's fallbacks."""
+    if support.fix_m is None:
+        return Feedback(previous_yhat + last_command, None)
+    if support.relative_m is None or fusion.xhat is None:
+        return Feedback(support.fix_m.copy(), None)
+    mu = support.mu
+    log_at_mu, log_at_xhat = fusion.log_p(np.vstack([mu, fusion.xhat]))
+    beta = float(1.0 / (1.0 + np.exp(np.clip(log_at_mu - log_at_xhat, -700, 700))))
+    yhat = beta * fusion.xhat + (1 - beta) * mu - support.relative_m
+    return Feedback(yhat, beta)
