@@ -1,0 +1,108 @@
+"""The GNSS-localizability map G (paper 4.1) and its smoothed field G_s (4.2).
+
+G holds one sigma per voxel, initialised from sigma_0 (what the ground station can predict from
+the structure and the sky) and pulled toward the observed GNSS error |p_n - yhat_n| by a Gaussian
+kernel around the voxel of yhat_n. G_s is tensor-product cubic Hermite interpolation with zero
+slope at the voxel centres, computed exactly as multilinear interpolation at the warped index
+i + s(t), s(t) = 3t^2 - 2t^3; outside the grid it takes the nearest border value.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import casadi as ca
+import numpy as np
+
+from mission.grid import VoxelGrid
+from mission.settings import MapSettings
+
+
+class LocalizabilityMap:
+    """G over a voxel grid; ``adaptive=False`` (the NAC baseline) switches the update off."""
+
+    def __init__(
+        self, grid: VoxelGrid, sigma0: np.ndarray, settings: MapSettings, adaptive: bool = True
+    ) -> None:
+        self.grid = grid
+        self.settings = settings
+        self.adaptive = adaptive
+        self.values = np.array(sigma0, dtype=float).reshape(grid.shape)
+        self.initial = self.values.copy()
+        reach = int(np.floor(settings.neighborhood + 1e-9))
+        self._offsets = np.array(list(itertools.product(range(-reach, reach + 1), repeat=3)))
+        self._d2 = grid.voxel_m * np.linalg.norm(self._offsets, axis=1)
+
+    def update(self, fix: np.ndarray, yhat: np.ndarray) -> int:
+        """sigma <- sigma + eta (e - sigma) exp(-D2^2 / (2 e^2)) around yhat's voxel.
+
+        Returns how many voxels changed (0 for NAC, or when yhat lies outside the grid).
+        """
+        if not self.adaptive:
+            return 0
+        lo = self.grid.origin_m
+        hi = lo + self.grid.voxel_m * np.array(self.grid.shape)
+        if np.any(yhat < lo) or np.any(yhat >= hi):
+            return 0
+        error = float(np.linalg.norm(np.asarray(fix) - np.asarray(yhat)))
+        centre = self.grid.index_of(np.asarray(yhat)[None])[0]
+        index = centre + self._offsets
+        valid = np.all((index >= 0) & (index < np.array(self.grid.shape)), axis=1)
+        index, d2 = index[valid], self._d2[valid]
+        if error > 0:
+            weight = np.exp(-(d2**2) / (2 * error**2))
+        else:
+            weight = (d2 == 0).astype(float)
+        cells = tuple(index.T)
+        self.values[cells] += self.settings.eta * (error - self.values[cells]) * weight
+        return int(np.count_nonzero(weight))
+
+    def smoothed(self, points: np.ndarray) -> np.ndarray:
+        """G_s at points (N, 3), in numpy."""
+        return hermite_zero_slope(self.values, self.grid, points)
+
+    def flat_values(self) -> np.ndarray:
+        """Values in the order the casadi interpolant expects (first axis fastest)."""
+        return self.values.ravel(order="F")
+
+
+def warped_index(u: np.ndarray | ca.MX, upper: np.ndarray) -> np.ndarray | ca.MX:
+    """i + s(t) for fractional voxel index u clipped to [0, upper], s(t) = 3t^2 - 2t^3."""
+    if isinstance(u, ca.MX | ca.SX):
+        clipped = ca.fmin(ca.fmax(u, 0), upper)
+        base = ca.fmin(ca.floor(clipped), ca.fmax(upper - 1, 0))
+        t = clipped - base
+        return base + 3 * t**2 - 2 * t**3
+    clipped = np.clip(u, 0, upper)
+    base = np.minimum(np.floor(clipped), np.maximum(upper - 1, 0))
+    t = clipped - base
+    return base + 3 * t**2 - 2 * t**3
+
+
+def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) -> np.ndarray:
+    """Zero-slope cubic Hermite interpolation of voxel values at points (numpy)."""
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    shape = np.array(grid.shape)
+    u = (points - grid.origin_m) / grid.voxel_m - 0.5
+    w = warped_index(u, (shape - 1).astype(float))
+    base = np.minimum(np.floor(w).astype(int), np.maximum(shape - 2, 0))
+    frac = w - base
+    result = np.zeros(len(points))
+    for corner in itertools.product((0, 1), repeat=3):
+        corner = np.array(corner)
+        index = np.minimum(base + corner, shape - 1)
+        weight = np.prod(np.where(corner == 1, frac, 1 - frac), axis=1)
+        result += weight * values[tuple(index.T)]
+    return result
+
+
+def casadi_smoothed(grid: VoxelGrid) -> ca.Function:
+    """G_s(x (3), values (nx*ny*nz, first axis fastest)) as a casadi Function."""
+    axes = [list(np.arange(n, dtype=float)) for n in grid.shape]
+    table = ca.interpolant("G", "linear", axes, 1)
+    x = ca.MX.sym("x", 3)
+    values = ca.MX.sym("values", grid.n_voxels)
+    upper = np.array(grid.shape, dtype=float) - 1
+    u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
+    warped = ca.vertcat(*(warped_index(u[a], upper[a]) for a in range(3)))
+    return ca.Function("G_s", [x, values], [table(warped, values)])
