@@ -1,0 +1,195 @@
+"""MPC of each support UAV (paper 4.2.2): casadi + IPOPT, built once per run.
+
+Decision variables: the U predicted positions V'_n. Cost, exactly the paper's four terms:
+
+  C_GNSS     = sum_u w_GNSS G_s(v_u)
+  C_interval = xi(|yhat - v_1|) + sum_u xi(|v_{u+1} - v_u|) + xi(|w_{n,k_{U+1}} - v_U|),
+               xi(d) = w_interval d^2 if d <= d_max else w_penalty d^2
+  C_waypoint = sum_u w_waypoint |v_u - w_{n,k_u}|^2
+  C_relative = sum_u (w_relative, or w_penalty if not observable) |v^(w)_u - v_u|^2
+
+Observability (range and line of sight between V^(w)_u and v_u) is not differentiable: it is
+evaluated on the initial guess (the previous solution shifted by one step), held fixed during
+the solve, and the problem is solved once more if the solution's flags differ (MODEL.md).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ground_station.localizability import casadi_smoothed_sx
+from mission.camera import CameraModel
+from mission.grid import VoxelGrid
+from mission.settings import ControlSettings
+
+IPOPT_OPTIONS = {
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "print_time": False,
+    "ipopt.max_iter": 50,
+    "ipopt.tol": 1e-6,
+    "ipopt.acceptable_tol": 1e-4,
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.hessian_approximation": "limited-memory",
+}
+
+
+@dataclass(frozen=True)
+class SupportPlan:
+    """The optimised local path V_n (U, 3) and how the solve went."""
+
+    path: np.ndarray
+    status: str
+    solve_ms: float
+    blocked: np.ndarray
+    resolved: bool
+
+    @property
+    def command(self) -> np.ndarray:
+        """The movement command: the first predicted position."""
+        return self.path[0]
+
+
+class SupportMpc:
+    """One NLP, built once, solved for any support with its own parameters.
+
+    G enters through a cube of voxels around yhat_n, wide enough for everything the horizon
+    can reach (U d_max plus a margin on each side), so a solve passes a few thousand values
+    rather than the whole map; the cube's corner is a parameter.
+    """
+
+    def __init__(
+        self,
+        control: ControlSettings,
+        grid: VoxelGrid,
+        camera: CameraModel,
+        hessian: str = "exact",
+    ) -> None:
+        self.control = control
+        self.grid = grid
+        self.camera = camera
+        self.horizon = control.horizon_steps
+        reach = control.horizon_steps * control.d_max_support_m + grid.voxel_m
+        half = int(np.ceil(reach / grid.voxel_m))
+        self.window = tuple(min(2 * half + 1, n) for n in grid.shape)
+        self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
+        self._hessian = hessian
+        self._solver = self._build()
+
+    def _build(self):
+        c, horizon = self.control, self.horizon
+        g_s = casadi_smoothed_sx(self._window_grid)
+        v = ca.SX.sym("v", 3, horizon)
+        yhat = ca.SX.sym("yhat", 3)
+        targets = ca.SX.sym("w", 3, horizon)
+        terminal = ca.SX.sym("terminal", 3)
+        work = ca.SX.sym("vw", 3, horizon)
+        blocked = ca.SX.sym("blocked", horizon)
+        values = ca.SX.sym("G", self._window_grid.n_voxels)
+        corner = ca.SX.sym("corner", 3)
+        d_max_sq = c.d_max_support_m**2
+
+        def xi(d_sq):
+            return ca.if_else(d_sq <= d_max_sq, c.w_interval * d_sq, c.w_penalty * d_sq)
+
+        def sq(a):
+            return ca.sumsqr(a)
+
+        # Steps are also bounded hard (below), where xi(d) = w_interval d^2 exactly: writing it
+        # so keeps the cost smooth; only the link to the terminal waypoint keeps the penalty.
+        cost = c.w_interval * sq(yhat - v[:, 0])
+        for u in range(horizon):
+            cost += c.w_gnss * g_s(v[:, u] - corner, values)
+            cost += c.w_waypoint * sq(v[:, u] - targets[:, u])
+            weight = c.w_relative + blocked[u] * (c.w_penalty - c.w_relative)
+            cost += weight * sq(work[:, u] - v[:, u])
+            if u + 1 < horizon:
+                cost += c.w_interval * sq(v[:, u + 1] - v[:, u])
+        cost += xi(sq(terminal - v[:, horizon - 1]))
+        parameters = ca.vertcat(
+            yhat, ca.vec(targets), terminal, ca.vec(work), blocked, corner, values
+        )
+        # The vehicle cannot fly faster than s_max: each predicted step is also bounded hard
+        # (the paper's penalty alone lets a discontinuous cost trap IPOPT beyond d_max).
+        steps = [sq(v[:, 0] - yhat)] + [sq(v[:, u + 1] - v[:, u]) for u in range(horizon - 1)]
+        nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": ca.vertcat(*steps)}
+        options = {**IPOPT_OPTIONS, "ipopt.hessian_approximation": self._hessian}
+        return ca.nlpsol("support_mpc", "ipopt", nlp, options)
+
+    def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(corner of the window in world coordinates, its values first-axis-fastest)."""
+        shape = np.array(self.grid.shape)
+        size = np.array(self.window)
+        centre = self.grid.index_of(np.asarray(yhat)[None])[0]
+        low = np.clip(centre - size // 2, 0, shape - size)
+        block = g_values[
+            low[0] : low[0] + size[0], low[1] : low[1] + size[1], low[2] : low[2] + size[2]
+        ]
+        corner = self.grid.origin_m + self.grid.voxel_m * low
+        return corner, block.ravel(order="F")
+
+    def solve(
+        self,
+        yhat: np.ndarray,
+        support_waypoints: np.ndarray,
+        work_path: np.ndarray,
+        work_indices: np.ndarray,
+        g_values: np.ndarray,
+        observable,
+        warm_start: np.ndarray | None = None,
+        escape: bool = False,
+    ) -> SupportPlan:
+        """Optimise V_n (``g_values``: G as a 3-D array; ``observable(a, b)``: rows of b
+        observable from rows of a)."""
+        horizon = self.horizon
+        targets = support_waypoints[work_indices[:horizon]]
+        terminal = support_waypoints[work_indices[horizon]]
+        work = work_path[:horizon]
+        guess = self._initial_guess(yhat, terminal, warm_start)
+        blocked = ~observable(guess, work)
+        start = time.perf_counter()
+        path, status, cost = self._solve_once(
+            yhat, targets, terminal, work, blocked, g_values, guess
+        )
+        if escape:  # G_s is flat at voxel centres: also start from paths leaving each way
+            for candidate in self._escape_guesses(yhat):
+                tried = self._solve_once(
+                    yhat, targets, terminal, work, blocked, g_values, candidate
+                )
+                if tried[2] < cost - 1e-9:
+                    path, status, cost = tried
+        resolved = False
+        after = ~observable(path, work)
+        if np.any(after != blocked):
+            path, status, _ = self._solve_once(yhat, targets, terminal, work, after, g_values, path)
+            blocked, resolved = after, True
+        elapsed = (time.perf_counter() - start) * 1000
+        return SupportPlan(path, status, elapsed, blocked, resolved)
+
+    def _initial_guess(
+        self, yhat: np.ndarray, terminal: np.ndarray, warm_start: np.ndarray | None
+    ) -> np.ndarray:
+        if warm_start is not None:
+            return np.vstack([warm_start[1:], warm_start[-1:]])
+        fractions = np.arange(1, self.horizon + 1)[:, None] / (self.horizon + 1)
+        return yhat + (terminal - yhat) * fractions
+
+    def _solve_once(self, yhat, targets, terminal, work, blocked, g_values, guess):
+        corner, window = self.window_of(yhat, g_values)
+        parameters = np.concatenate(
+            [yhat, targets.ravel(), terminal, work.ravel(), blocked.astype(float), corner, window]
+        )
+        result = self._solver(x0=guess.ravel(), p=parameters, lbg=-np.inf,
+                              ubg=self.control.d_max_support_m**2 * (1 + 1e-6))
+        status = self._solver.stats()["return_status"]
+        path = np.array(result["x"]).reshape(self.horizon, 3)
+        return path, status, float(result["f"])
+
+    def _escape_guesses(self, yhat: np.ndarray) -> list[np.ndarray]:
+        """Straight paths at d_max per step along +-x, +-y, +-z."""
+        steps = np.arange(1, self.horizon + 1)[:, None] * self.control.d_max_support_m
+        return [yhat + steps * direction for direction in np.vstack([np.eye(3), -np.eye(3)])]

@@ -1,0 +1,95 @@
+"""Work MPC (Algorithm 1) by hand; support MPC behaviour with G unchanged and raised."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
+from ground_station.support_mpc import SupportMpc
+from ground_station.work_mpc import predict_work
+from mission.plan_files import read_plan
+
+
+def test_work_mpc_steps_greedily_and_advances_the_index():
+    waypoints = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 0.5, 0]])
+    prediction = predict_work(
+        np.array([0.0, 0, 0]), 1, waypoints, horizon=5, d_max_m=0.3, arrival_tol_m=0.1
+    )
+    expected = [[0.3, 0, 0], [0.6, 0, 0], [0.9, 0, 0], [1.0, 0, 0], [1.0, 0.3, 0], [1.0, 0.5, 0]]
+    np.testing.assert_allclose(prediction.path, expected, atol=1e-12)
+    # k is recorded before the arrival check: step 4 arrives at w_1, so step 5 targets w_2.
+    assert prediction.indices.tolist() == [1, 1, 1, 1, 2, 2]
+    np.testing.assert_allclose(prediction.command, [0.3, 0, 0])
+
+
+def test_work_mpc_stays_on_the_last_waypoint():
+    waypoints = np.array([[0.0, 0, 0], [0.05, 0, 0]])
+    prediction = predict_work(np.zeros(3), 1, waypoints, 3, 0.3, 0.1)
+    assert prediction.indices.tolist() == [1, 1, 1, 1]
+    np.testing.assert_allclose(prediction.path[-1], waypoints[1])
+
+
+@pytest.fixture(scope="module")
+def setting(along_world):
+    scenario = along_world.scenario
+    plan = read_plan(scenario)
+    grid = along_world.map_grid()
+    mpc = SupportMpc(scenario.control, grid, along_world.camera)
+    return along_world, plan, grid, mpc
+
+
+def _run(setting, adaptive_raise: bool, cycles: int = 12):
+    world, plan, grid, mpc = setting
+    scenario = world.scenario
+    g = LocalizabilityMap(grid, world.sigma0_map().sigma_m, scenario.map, adaptive=True)
+    yhat = plan.supports[0][5].copy()  # w_1,6, the Wall scenario's waypoint
+    raised = None
+    if adaptive_raise:
+        centre = grid.index_of(yhat[None])[0]
+        lo, hi = np.maximum(centre - 1, 0), centre + 2
+        g.values[lo[0] : hi[0], lo[1] : hi[1], lo[2] : hi[2]] = 2.0
+        raised = (grid.origin_m + lo * grid.voxel_m, grid.origin_m + hi * grid.voxel_m)
+    xhat, k = plan.work[5].copy(), 5
+    warm, positions, steps = None, [], []
+    for _ in range(cycles):
+        work = predict_work(
+            xhat,
+            k,
+            plan.work,
+            scenario.control.horizon_steps,
+            scenario.control.d_max_work_m,
+            scenario.control.arrival_tol_m,
+        )
+        escape = bool(g.smoothed(yhat)[0] > hermite_zero_slope(g.initial, grid, yhat)[0] + 0.05)
+        result = mpc.solve(
+            yhat,
+            plan.supports[0],
+            work.path,
+            work.indices,
+            g.values,
+            world.camera.observable,
+            warm,
+            escape=escape,
+        )
+        steps.append(np.linalg.norm(np.diff(np.vstack([yhat, result.path]), axis=0), axis=1))
+        warm = result.path
+        move = result.command - yhat
+        reach = scenario.control.s_max_support_m_s * scenario.control.t_cont_s
+        yhat = yhat + move * min(1.0, reach / max(np.linalg.norm(move), 1e-12))
+        positions.append(yhat.copy())
+    return np.array(positions), raised, np.concatenate(steps), plan.supports[0][5]
+
+
+def test_with_g_unchanged_the_plan_follows_the_pre_planned_path(setting):
+    positions, _, steps, waypoint = _run(setting, adaptive_raise=False)
+    # The relative term pulls a little toward the work UAV; it stays near its waypoint.
+    assert np.max(np.linalg.norm(positions - waypoint, axis=1)) < 1.0
+    assert np.all(steps <= setting[0].scenario.control.d_max_support_m + 0.05)
+
+
+def test_with_g_raised_around_the_uav_the_plan_leaves_the_region(setting):
+    positions, (lo, hi), steps, _ = _run(setting, adaptive_raise=True)
+    inside = np.all((positions >= lo) & (positions <= hi), axis=1)
+    assert not inside[3:].any(), f"still inside after 3 cycles: {inside}"
+    assert np.all(steps <= setting[0].scenario.control.d_max_support_m + 0.05)
