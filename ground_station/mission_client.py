@@ -37,6 +37,7 @@ class MissionClient:
         self.timeout_s = timeout_s
         self.retries = retries
         self.on_other = on_other or (lambda message, sender: None)
+        self.on_sent: Callable[[bytes], None] | None = None
 
     def upload(self, items: list[MissionItem]) -> int:
         """Send ``items``; return the vehicle's MAV_MISSION_RESULT (raise if it stops answering)."""
@@ -96,7 +97,9 @@ class MissionClient:
         raise MissionTransferError(f"system {self.system_id}: download timed out")
 
     def _send(self, message: Any) -> None:
-        self.endpoint.send(message, [self.vehicle])
+        packet = self.endpoint.send(message, [self.vehicle])
+        if self.on_sent is not None:
+            self.on_sent(packet)
 
     def _wait(self, wanted: set[str], seq: int | None = None) -> Any | None:
         own = self.endpoint.codec.system_id

@@ -183,8 +183,12 @@ class SupportMpc:
         parameters = np.concatenate(
             [yhat, targets.ravel(), terminal, work.ravel(), blocked.astype(float), corner, window]
         )
-        result = self._solver(x0=guess.ravel(), p=parameters, lbg=-np.inf,
-                              ubg=self.control.d_max_support_m**2 * (1 + 1e-6))
+        result = self._solver(
+            x0=guess.ravel(),
+            p=parameters,
+            lbg=-np.inf,
+            ubg=self.control.d_max_support_m**2 * (1 + 1e-6),
+        )
         status = self._solver.stats()["return_status"]
         path = np.array(result["x"]).reshape(self.horizon, 3)
         return path, status, float(result["f"])

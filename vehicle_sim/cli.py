@@ -11,8 +11,8 @@ from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
 from mission.errors import InputError
 from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.plan_files import read_vehicle_waypoints
+from mission.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
 from mission.world import World
-from vehicle_sim.identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
 from vehicle_sim.server import ClockSettings, VehicleServer, install_signal_handlers
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle

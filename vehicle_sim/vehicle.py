@@ -18,9 +18,9 @@ from mission.frames import GeodeticFrame, ned_to_enu
 from mission.mavlink_udp import LinkCounters
 from mission.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
 from mission.settings import Scenario
+from mission.vehicle_identity import VehicleIdentity
 from mission.world import World
 from vehicle_sim import modes, telemetry
-from vehicle_sim.identity import VehicleIdentity
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
 

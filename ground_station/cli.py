@@ -1,0 +1,119 @@
+"""``python -m ground_station``: run the ground station of one mission."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from mission.cli_common import OneLineArgumentParser, run_guarded
+from mission.errors import InputError
+from mission.mavlink_udp import parse_address
+from mission.plan_files import vehicle_names
+from mission.vehicle_identity import BASE_PORT, VehicleIdentity
+from mission.world import World
+
+
+def build_parser() -> OneLineArgumentParser:
+    """Arguments of the ground-station process."""
+    parser = OneLineArgumentParser(prog="python -m ground_station", description=__doc__)
+    parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
+    parser.add_argument(
+        "--method",
+        choices=["ac", "nac"],
+        default="ac",
+        help="ac: adaptive (G updated); nac: the baseline without the update",
+    )
+    links = parser.add_mutually_exclusive_group()
+    links.add_argument(
+        "--vehicles",
+        metavar="work=HOST:PORT,support-1=HOST:PORT,...",
+        help="where each vehicle listens",
+    )
+    links.add_argument(
+        "--base-port",
+        type=int,
+        default=BASE_PORT,
+        help=f"vehicles on 127.0.0.1:BASE+instance (default {BASE_PORT})",
+    )
+    parser.add_argument(
+        "--waypoints",
+        type=Path,
+        metavar="DIR",
+        help="the vehicles' waypoint files (default: the scenario's plan)",
+    )
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--out",
+        type=Path,
+        metavar="DIR",
+        help="where gcs.tlog, records.jsonl and g/ go (default logs/gcs-TIME)",
+    )
+    parser.add_argument(
+        "--speedup", type=float, help="real time, this many times faster (default: lockstep)"
+    )
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run a mission and print its summary as JSON."""
+    from ground_station.station import GroundStation, StationConfig, StationError
+
+    args = build_parser().parse_args(argv)
+    world = World.load(args.scenario)
+    scenario = world.scenario
+    vehicles = _vehicle_addresses(args, scenario.task.supports)
+    waypoints = args.waypoints or Path(scenario.task.waypoints_dir)
+    if not waypoints.is_dir():
+        raise InputError("command line", "--waypoints", f"{waypoints} is not a directory")
+    out = args.out or Path("logs") / f"gcs-{time.strftime('%Y%m%d-%H%M%S')}"
+    config = StationConfig(
+        adaptive=args.method == "ac",
+        vehicles=vehicles,
+        waypoints_dir=waypoints,
+        out_dir=out,
+        seed=args.seed,
+        speedup=args.speedup,
+    )
+    station = GroundStation(world, config)
+    try:
+        summary = station.run()
+    except StationError as error:
+        print(f"ground station: {error}", file=sys.stderr)
+        return 1
+    finally:
+        station.close()
+    print(
+        json.dumps({"scenario": scenario.name, "method": args.method, "seed": args.seed, **summary})
+    )
+    return 0
+
+
+def _vehicle_addresses(args, supports: int) -> dict:
+    if args.vehicles is None:
+        return {
+            name: ("127.0.0.1", VehicleIdentity.parse(name).default_port(args.base_port))
+            for name in vehicle_names(supports)
+        }
+    vehicles = {}
+    for item in args.vehicles.split(","):
+        name, sep, address = item.partition("=")
+        try:
+            VehicleIdentity.parse(name.strip())
+            vehicles[name.strip()] = parse_address(address.strip(), name)
+        except ValueError as error:
+            raise InputError(
+                "command line",
+                "--vehicles",
+                str(error) if sep else f"expected NAME=HOST:PORT, got {item!r}",
+            ) from None
+    if "work" not in vehicles or len(vehicles) < 2:
+        raise InputError("command line", "--vehicles", "needs the work UAV and a support")
+    return vehicles
+
+
+def entry_point(argv: Sequence[str] | None = None) -> int:
+    """Run with one-line errors and exit status 2 on bad input."""
+    return run_guarded(main, argv)

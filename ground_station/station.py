@@ -1,0 +1,357 @@
+"""The ground-station process: links to every vehicle, missions, the run loop, logs.
+
+Every packet received or sent goes to the tlog stamped with simulated time from the scenario's
+epoch; the per-cycle record and snapshots of G are written alongside as the run goes.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from ground_station.cycle import CycleOutput, Models, StationState, control_cycle
+from ground_station.localizability import LocalizabilityMap
+from ground_station.measurements import support_measurement
+from ground_station.mission_client import MissionClient, MissionTransferError
+from ground_station.support_mpc import SupportMpc
+from ground_station.tlog import TlogWriter
+from mission.frames import GeodeticFrame, enu_to_ned
+from mission.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.vehicle_identity import VehicleIdentity
+from mission.waypoints import read_waypoints
+from mission.world import World
+
+GCS_SYSTEM_ID = 255
+GCS_COMPONENT_ID = 190
+POSITION_ONLY = 0b0000_1101_1111_1000
+SNAPSHOT_EVERY = 20
+
+
+class StationError(RuntimeError):
+    """The run cannot go on (a vehicle never appeared, refused its mission, ...)."""
+
+
+@dataclass(frozen=True)
+class StationConfig:
+    """How this ground station runs."""
+
+    adaptive: bool
+    vehicles: dict[str, Address]
+    waypoints_dir: Path
+    out_dir: Path
+    seed: int = 0
+    speedup: float | None = None  # None: lockstep
+    step_timeout_wall_s: float = 5.0
+    connect_timeout_wall_s: float = 30.0
+
+
+@dataclass
+class VehicleView:
+    """What the ground station holds about one vehicle."""
+
+    name: str
+    system_id: int
+    address: Address
+    latest: dict[str, Any] = field(default_factory=dict)
+    step_ms: int = -1
+    heartbeat_wall: float = -1.0
+
+
+class GroundStation:
+    """Runs one mission over MAVLink and logs everything."""
+
+    def __init__(self, world: World, config: StationConfig) -> None:
+        self.world = world
+        self.scenario = world.scenario
+        self.config = config
+        self.frame = GeodeticFrame(self.scenario.world.anchor)
+        self.endpoint = UdpEndpoint(MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID))
+        self.queue = MessageQueue(self.endpoint)
+        config.out_dir.mkdir(parents=True, exist_ok=True)
+        self.tlog = TlogWriter(config.out_dir / "gcs.tlog")
+        self.records = (config.out_dir / "records.jsonl").open("w", encoding="utf-8")
+        self.snapshots = config.out_dir / "g"
+        self.snapshots.mkdir(exist_ok=True)
+        self.views = {
+            name: VehicleView(name, VehicleIdentity.parse(name).system_id, address)
+            for name, address in config.vehicles.items()
+        }
+        self.by_system = {v.system_id: v for v in self.views.values()}
+        self.sim_time_s = 0.0
+        self.cycles = 0
+
+    # -- links ------------------------------------------------------------------------------
+    @property
+    def time_usec(self) -> int:
+        """Simulated time from the scenario's epoch, for the tlog."""
+        return round((self.scenario.run.epoch_unix_s + self.sim_time_s) * 1e6)
+
+    def send(self, message: Any, view: VehicleView) -> None:
+        """Send to one vehicle and log the packet."""
+        packet = self.endpoint.send(message, [view.address])
+        self.tlog.write(self.time_usec, packet)
+
+    def _log_received(self, message: Any, sender: Address) -> None:
+        self.tlog.write(self.time_usec, message.get_msgbuf())
+        view = self.by_system.get(message.get_srcSystem())
+        if view is None:
+            return
+        kind = message.get_type()
+        view.latest[kind] = message
+        if kind == "HEARTBEAT":
+            view.heartbeat_wall = time.monotonic()
+        elif kind == "SYSTEM_TIME":
+            view.step_ms = int(message.time_boot_ms)
+
+    def pump(self, seconds: float, until: Callable[[], bool] | None = None) -> None:
+        """Receive and log for up to ``seconds`` or until ``until()`` holds."""
+        deadline = time.monotonic() + seconds
+        while until is None or not until():
+            got = self.queue.next(deadline - time.monotonic())
+            if got is None:
+                return
+            self._log_received(*got)
+
+    # -- set-up -----------------------------------------------------------------------------
+    def connect(self) -> None:
+        """Wait for every vehicle's heartbeat (announcing ourselves so they answer)."""
+        beat = mavlink2.MAVLink_heartbeat_message(
+            mavlink2.MAV_TYPE_GCS, mavlink2.MAV_AUTOPILOT_INVALID, 0, 0, 0, 3
+        )
+        deadline = time.monotonic() + self.config.connect_timeout_wall_s
+        while time.monotonic() < deadline:
+            for view in self.views.values():
+                self.send(beat, view)
+            self.pump(0.5, lambda: all(v.heartbeat_wall > 0 for v in self.views.values()))
+            if all(v.heartbeat_wall > 0 for v in self.views.values()):
+                return
+        missing = [v.name for v in self.views.values() if v.heartbeat_wall < 0]
+        raise StationError(f"no heartbeat from {', '.join(missing)}")
+
+    def upload_missions(self) -> dict[str, np.ndarray]:
+        """Upload each vehicle's waypoint file; return their waypoints (ENU, home excluded)."""
+        from mission.waypoints import row_position_enu
+
+        waypoints = {}
+        for view in self.views.values():
+            rows = read_waypoints(self.config.waypoints_dir / f"{view.name}.waypoints")
+            client = MissionClient(
+                self.queue, view.address, view.system_id, on_other=self._log_received
+            )
+            client.on_sent = lambda packet: self.tlog.write(self.time_usec, packet)
+            try:
+                result = client.upload([row.to_item() for row in rows])
+            except MissionTransferError as error:
+                raise StationError(f"{view.name}: {error}") from None
+            if result != mavlink2.MAV_MISSION_ACCEPTED:
+                raise StationError(f"{view.name} refused its mission (MAV_MISSION_RESULT {result})")
+            waypoints[view.name] = np.array([row_position_enu(r, self.frame) for r in rows[1:]])
+        return waypoints
+
+    def arm_all(self) -> None:
+        """GUIDED and armed, each acknowledged."""
+        for view in self.views.values():
+            for command, params in (
+                (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
+                (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1, 0)),
+            ):
+                self.send(
+                    mavlink2.MAVLink_command_long_message(
+                        view.system_id, 1, command, 0, *params, 0, 0, 0, 0, 0
+                    ),
+                    view,
+                )
+                self.pump(3.0, lambda v=view, c=command: _acked(v, c))
+                if not _acked(view, command):
+                    raise StationError(f"{view.name} did not accept command {command}")
+                view.latest.pop("COMMAND_ACK", None)
+
+    # -- the run ----------------------------------------------------------------------------
+    def run(self) -> dict[str, Any]:
+        """Connect, upload, arm, then cycle until done or timeout; return a summary."""
+        start_wall = time.monotonic()
+        self.connect()
+        waypoints = self.upload_missions()
+        self.arm_all()
+        models, state = self._initial(waypoints)
+        supports = [n for n in self.views if n != "work"]
+        self._snapshot(models.g, "initial")
+        completion = None
+        scn = self.scenario
+        while self.sim_time_s < scn.run.timeout_s - 1e-9:
+            self._advance_clock()
+            measurements = [
+                support_measurement(
+                    name,
+                    self._current(name, "GPS_RAW_INT"),
+                    self._current(name, "LANDING_TARGET"),
+                    self.world,
+                    self.frame,
+                )
+                for name in supports
+            ]
+            output = control_cycle(state, measurements, models)
+            self._command(state, output)
+            self._record(state, output)
+            self.cycles += 1
+            if self.cycles % SNAPSHOT_EVERY == 0:
+                self._snapshot(models.g, f"{self.cycles:05d}")
+            self.tlog.flush()
+            if state.completed:
+                completion = self.sim_time_s
+                self._announce(f"Mission complete at {completion:.1f} s")
+                break
+        self._snapshot(models.g, "final")
+        self.tlog.flush()
+        return {
+            "completed": completion is not None,
+            "completion_time_s": completion,
+            "control_cycles": self.cycles,
+            "sim_time_s": self.sim_time_s,
+            "wall_time_s": time.monotonic() - start_wall,
+        }
+
+    def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
+        scn = self.scenario
+        grid = self.world.map_grid()
+        g = LocalizabilityMap(grid, self.world.sigma0_map().sigma_m, scn.map, self.config.adaptive)
+        models = Models(
+            scn,
+            self.world,
+            waypoints["work"],
+            {n: w for n, w in waypoints.items() if n != "work"},
+            g,
+            SupportMpc(scn.control, grid, self.world.camera),
+            np.random.default_rng(self.config.seed),
+        )
+        state = StationState(
+            xhat=waypoints["work"][0].copy(),
+            yhat={n: w[0].copy() for n, w in models.support_waypoints.items()},
+            k=min(1, len(waypoints["work"]) - 1),
+        )
+        return models, state
+
+    def _advance_clock(self) -> None:
+        step = self.scenario.control.t_cont_s
+        if self.config.speedup is None:
+            target_ms = round((self.sim_time_s + step) * 1000)
+            self.sim_time_s = target_ms / 1000.0
+            tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
+            for view in self.views.values():
+                self.send(tick, view)
+            self.pump(
+                self.config.step_timeout_wall_s,
+                lambda: all(v.step_ms >= target_ms for v in self.views.values()),
+            )
+        else:
+            self.pump(step / self.config.speedup)
+            self.sim_time_s += step
+
+    def _current(self, name: str, kind: str) -> Any | None:
+        """The vehicle's message of this kind from the current step (None if late or missing)."""
+        message = self.views[name].latest.get(kind)
+        if message is None:
+            return None
+        if self.config.speedup is None:
+            step_usec = self.time_usec
+            if abs(int(message.time_usec) - step_usec) > 1000:
+                return None
+        return message
+
+    def _command(self, state: StationState, output: CycleOutput) -> None:
+        work = self.views["work"]
+        self._estimate(state.xhat, work)
+        self._setpoint(output.work_target, work)
+        for name, target in output.support_targets.items():
+            self._estimate(state.yhat[name], self.views[name])
+            self._setpoint(target, self.views[name])
+        if output.arrived is not None and not state.completed:
+            self.send(
+                mavlink2.MAVLink_mission_set_current_message(work.system_id, 1, state.k + 1), work
+            )
+            self._announce(f"Work UAV reached waypoint {output.arrived + 1}")
+
+    def _estimate(self, position: np.ndarray, view: VehicleView) -> None:
+        n, e, d = (float(v) for v in enu_to_ned(position))
+        self.send(
+            mavlink2.MAVLink_vision_position_estimate_message(self.time_usec, n, e, d, 0, 0, 0),
+            view,
+        )
+
+    def _setpoint(self, target: np.ndarray, view: VehicleView) -> None:
+        n, e, d = (float(v) for v in enu_to_ned(target))
+        self.send(
+            mavlink2.MAVLink_set_position_target_local_ned_message(
+                round(self.sim_time_s * 1000),
+                view.system_id,
+                1,
+                mavlink2.MAV_FRAME_LOCAL_NED,
+                POSITION_ONLY,
+                n,
+                e,
+                d,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+                0,
+            ),
+            view,
+        )
+
+    def _announce(self, text: str) -> None:
+        message = mavlink2.MAVLink_statustext_message(
+            mavlink2.MAV_SEVERITY_INFO, text.encode()[:50], 0, 0
+        )
+        self.tlog.write(self.time_usec, self.endpoint.send(message, []))
+
+    def _record(self, state: StationState, output: CycleOutput) -> None:
+        fusion = output.fusion
+        record = {
+            "t": round(self.sim_time_s, 3),
+            "k": state.k,
+            "xhat": _round(state.xhat),
+            "blind": fusion.blind,
+            "fallback": fusion.fallback,
+            "consistent": list(fusion.consistent),
+            "contributing": list(fusion.contributing),
+            "yhat": {n: _round(y) for n, y in state.yhat.items()},
+            "beta": output.betas,
+            "arrived": output.arrived,
+            "g_updated_voxels": output.updated_voxels,
+            "mpc": {
+                n: {"status": p.status, "ms": round(p.solve_ms, 3), "resolved": p.resolved}
+                for n, p in output.support_plans.items()
+            },
+            "cycle_ms": round(output.cycle_ms, 3),
+        }
+        self.records.write(json.dumps(record) + "\n")
+        self.records.flush()
+
+    def _snapshot(self, g: LocalizabilityMap, label: str) -> None:
+        np.save(self.snapshots / f"G_{label}.npy", g.values)
+
+    def close(self) -> None:
+        """Flush and close every file and the socket."""
+        self.tlog.close()
+        self.records.close()
+        self.endpoint.close()
+
+
+def _acked(view: VehicleView, command: int) -> bool:
+    ack = view.latest.get("COMMAND_ACK")
+    return ack is not None and ack.command == command and ack.result == 0
+
+
+def _round(v: np.ndarray) -> list[float]:
+    return [round(float(x), 4) for x in v]
