@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ground_station.localizability import casadi_smoothed_sx
+from ground_station.localizability import casadi_smoothed, casadi_smoothed_sx
 from mission.camera import CameraModel
 from mission.grid import VoxelGrid
 from mission.settings import ControlSettings
@@ -68,6 +68,7 @@ class SupportMpc:
         grid: VoxelGrid,
         camera: CameraModel,
         hessian: str = "exact",
+        symbolic: str = "MX",
     ) -> None:
         self.control = control
         self.grid = grid
@@ -78,19 +79,21 @@ class SupportMpc:
         self.window = tuple(min(2 * half + 1, n) for n in grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
         self._hessian = hessian
+        self.symbolic = symbolic
         self._solver = self._build()
 
     def _build(self):
         c, horizon = self.control, self.horizon
-        g_s = casadi_smoothed_sx(self._window_grid)
-        v = ca.SX.sym("v", 3, horizon)
-        yhat = ca.SX.sym("yhat", 3)
-        targets = ca.SX.sym("w", 3, horizon)
-        terminal = ca.SX.sym("terminal", 3)
-        work = ca.SX.sym("vw", 3, horizon)
-        blocked = ca.SX.sym("blocked", horizon)
-        values = ca.SX.sym("G", self._window_grid.n_voxels)
-        corner = ca.SX.sym("corner", 3)
+        sym = ca.SX if self.symbolic == "SX" else ca.MX
+        g_s = (casadi_smoothed_sx if self.symbolic == "SX" else casadi_smoothed)(self._window_grid)
+        v = sym.sym("v", 3, horizon)
+        yhat = sym.sym("yhat", 3)
+        targets = sym.sym("w", 3, horizon)
+        terminal = sym.sym("terminal", 3)
+        work = sym.sym("vw", 3, horizon)
+        blocked = sym.sym("blocked", horizon)
+        values = sym.sym("G", self._window_grid.n_voxels)
+        corner = sym.sym("corner", 3)
         d_max_sq = c.d_max_support_m**2
 
         def xi(d_sq):

@@ -54,7 +54,7 @@ def vehicle_process(
     vehicle: str,
     *args: str,
     scenario: str = "along",
-    home: tuple[float, float, float] = (0.0, -10.0, 7.0),
+    home: tuple[float, float, float] | None = (0.0, -10.0, 7.0),
 ) -> Iterator[VehicleProcess]:
     """Run one vehicle on a free port for the duration of the ``with`` block."""
     command = [
@@ -67,8 +67,7 @@ def vehicle_process(
         vehicle,
         "--port",
         "0",
-        "--home",
-        *map(str, home),
+        *(["--home", *map(str, home)] if home is not None else []),
         *args,
     ]
     process = subprocess.Popen(

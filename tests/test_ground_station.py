@@ -1,0 +1,132 @@
+"""The ground station against real vehicle processes: a short mission end to end."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pymavlink import mavutil
+
+from mission.plan_files import write_plan
+from mission.planner import plan_supports
+from mission.scenario import load_scenario
+from mission.world import World
+from tests.processes import ROOT, vehicle_process
+
+SHORT = """
+extends: along
+name: short-along
+task:
+  work_waypoints_m: [[-6.0, -3.0, 7.0], [-3.0, -3.0, 7.0], [0.0, -3.0, 7.0]]
+  waypoints_dir: plan
+run: {{timeout_s: 120.0}}
+world:
+  zones:
+    - {{name: test, min_m: {lo}, max_m: {hi}, offset_m: [1.0, 0.0, 0.0]}}
+"""
+
+
+@pytest.fixture(scope="module")
+def short_scenario(tmp_path_factory) -> Path:
+    directory = tmp_path_factory.mktemp("short")
+    path = directory / "short.yaml"
+    path.write_text(SHORT.format(lo=[24.0, 19.0, 0.0], hi=[25.0, 20.0, 1.0]))
+    world = World(load_scenario(str(path)))
+    plan = plan_supports(world)
+    write_plan(plan, world.scenario, directory / "plan")
+    # Put the zone around support 1's first waypoints so the map has something to learn.
+    start = plan.supports[0][0]
+    lo, hi = (start - [0.5, 2.5, 1.0]).tolist(), (start + [0.5, 2.5, 1.0]).tolist()
+    path.write_text(SHORT.format(lo=lo, hi=hi))
+    return path
+
+
+@contextlib.contextmanager
+def fleet(scenario: Path):
+    """Three supports, then the work UAV (sending them its truth), all in lockstep."""
+    with (
+        vehicle_process("support-1", scenario=str(scenario), home=None) as s1,
+        vehicle_process("support-2", scenario=str(scenario), home=None) as s2,
+        vehicle_process("support-3", scenario=str(scenario), home=None) as s3,
+    ):
+        truth = [a for s in (s1, s2, s3) for a in ("--truth-out", f"127.0.0.1:{s.truth_port}")]
+        with vehicle_process("work", *truth, scenario=str(scenario), home=None) as work:
+            yield {"work": work, "support-1": s1, "support-2": s2, "support-3": s3}
+
+
+def _run_station(scenario: Path, out: Path, method: str, vehicles) -> dict:
+    addresses = ",".join(f"{n}=127.0.0.1:{v.port}" for n, v in vehicles.items())
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "ground_station",
+            "--scenario",
+            str(scenario),
+            "--method",
+            method,
+            "--vehicles",
+            addresses,
+            "--out",
+            str(out),
+            "--seed",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def test_a_short_mission_completes_and_is_logged(short_scenario, tmp_path):
+    with fleet(short_scenario) as vehicles:
+        summary = _run_station(short_scenario, tmp_path, "ac", vehicles)
+    assert summary["completed"] is True
+    assert 20 < summary["completion_time_s"] < 120
+    records = [json.loads(line) for line in (tmp_path / "records.jsonl").read_text().splitlines()]
+    assert len(records) == summary["control_cycles"]
+    assert records[-1]["k"] == 2 and records[-1]["arrived"] == 2
+    assert sum(r["g_updated_voxels"] > 0 for r in records) > 0
+    initial = np.load(tmp_path / "g" / "G_initial.npy")
+    final = np.load(tmp_path / "g" / "G_final.npy")
+    assert np.any(final != initial), "AC learns the map"
+    counts: dict[str, int] = {}
+    log = mavutil.mavlink_connection(str(tmp_path / "gcs.tlog"), dialect="ardupilotmega")
+    while (message := log.recv_match()) is not None:
+        counts[message.get_type()] = counts.get(message.get_type(), 0) + 1
+    for kind in (
+        "SIM_STATE",
+        "GPS_RAW_INT",
+        "LANDING_TARGET",
+        "SET_POSITION_TARGET_LOCAL_NED",
+        "VISION_POSITION_ESTIMATE",
+        "MISSION_ITEM_INT",
+        "SYSTEM_TIME",
+    ):
+        assert counts.get(kind, 0) > 0, kind
+    assert counts["SET_POSITION_TARGET_LOCAL_NED"] == 4 * summary["control_cycles"]
+
+
+def test_mavlogdump_reads_the_tlog_and_nac_leaves_g(short_scenario, tmp_path):
+    with fleet(short_scenario) as vehicles:
+        summary = _run_station(short_scenario, tmp_path, "nac", vehicles)
+    assert summary["control_cycles"] > 0
+    initial = np.load(tmp_path / "g" / "G_initial.npy")
+    np.testing.assert_array_equal(np.load(tmp_path / "g" / "G_final.npy"), initial)
+    dump = Path(sys.executable).parent / "mavlogdump.py"
+    result = subprocess.run(
+        [sys.executable, str(dump), "--types", "SIM_STATE", str(tmp_path / "gcs.tlog")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.count("SIM_STATE") >= summary["control_cycles"] * 4
