@@ -130,3 +130,64 @@ def test_mavlogdump_reads_the_tlog_and_nac_leaves_g(short_scenario, tmp_path):
     )
     assert result.returncode == 0, result.stderr
     assert result.stdout.count("SIM_STATE") >= summary["control_cycles"] * 4
+
+
+def test_sim_state_never_reaches_the_estimator(along, tmp_path):
+    """Same measurements, wildly different SIM_STATE: identical commands and estimates."""
+    from ground_station.cycle import control_cycle
+    from ground_station.measurements import support_measurement
+    from ground_station.station import GroundStation, StationConfig
+    from mission.frames import GeodeticFrame
+    from mission.mavlink_udp import MavlinkCodec
+    from mission.plan_files import read_plan
+    from vehicle_sim import telemetry
+
+    world = World(along)
+    plan = read_plan(along)
+    frame = GeodeticFrame(along.world.anchor)
+    outputs = []
+    for truth_shift in (0.0, 50.0):
+        config = StationConfig(
+            True,
+            {n: ("127.0.0.1", 9) for n in ("work", "support-1", "support-2", "support-3")},
+            Path(along.task.waypoints_dir),
+            tmp_path / str(truth_shift),
+        )
+        station = GroundStation(world, config)
+        models, state = station._initial(
+            {"work": plan.work, **{f"support-{n + 1}": plan.supports[n] for n in range(3)}}
+        )
+        station.sim_time_s = 0.5
+        messages_rng = np.random.default_rng(11)
+        for n in range(3):
+            name, codec = f"support-{n + 1}", MavlinkCodec(n + 2, 1)
+            y = plan.supports[n][0]
+            fix = world.gnss.sample_fix(y, messages_rng)
+            obs = world.camera.observe(y, plan.work[0], messages_rng)
+            for message in (
+                telemetry.gps_raw_int(fix, frame, station.time_usec, 0.1),
+                telemetry.landing_target(obs, station.time_usec, 1),
+                telemetry.sim_state(y + truth_shift, np.zeros(3), frame),
+            ):
+                decoded = codec.decode(codec.encode(message))[0][0]
+                station._log_received(decoded, ("127.0.0.1", 9))
+        measurements = [
+            support_measurement(
+                name,
+                station._current(name, "GPS_RAW_INT"),
+                station._current(name, "LANDING_TARGET"),
+                world,
+                frame,
+            )
+            for name in ("support-1", "support-2", "support-3")
+        ]
+        assert all(m.contributes for m in measurements)
+        assert station.views["support-1"].latest["SIM_STATE"].get_type() == "SIM_STATE"
+        output = control_cycle(state, measurements, models)
+        outputs.append((output.work_target, output.support_targets, state.xhat.copy()))
+        station.close()
+    (work_a, supports_a, xhat_a), (work_b, supports_b, xhat_b) = outputs
+    np.testing.assert_array_equal(work_a, work_b)
+    np.testing.assert_array_equal(xhat_a, xhat_b)
+    for name in supports_a:
+        np.testing.assert_array_equal(supports_a[name], supports_b[name])
