@@ -26,7 +26,7 @@ from ground_station.work_mpc import WorkPrediction, predict_work
 from mission.settings import Scenario
 from mission.world import World
 
-ESCAPE_MARGIN_M = 0.05
+ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape starts too
 
 
 @dataclass

@@ -35,18 +35,32 @@ def relative_observation(message: Any | None) -> np.ndarray | None:
 def support_measurement(
     name: str, gps: Any | None, target: Any | None, world: World, frame: GeodeticFrame
 ) -> SupportMeasurement:
-    """p_n, r_n and their covariances, evaluated at the measured values (MODEL.md 3.2.1)."""
+    """p_n, r_n and their covariances from the step's GPS_RAW_INT and LANDING_TARGET."""
     fix = gnss_fix(gps, frame)
+    reported = None
+    if fix is not None:
+        h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
+        reported = np.diag([h * h / 2, h * h / 2, v * v])
+    return measurement_from_values(name, fix, relative_observation(target), world, reported)
+
+
+def measurement_from_values(
+    name: str,
+    fix: np.ndarray | None,
+    relative: np.ndarray | None,
+    world: World,
+    reported: np.ndarray | None = None,
+) -> SupportMeasurement:
+    """Covariances evaluated at the measured values (MODEL.md 3.2.1).
+
+    Where the model sees no fix at p_n but the receiver has one, the receiver's reported
+    accuracy stands in for Sigma_GNSS.
+    """
     sigma_gnss = None
     if fix is not None:
         has_fix, sigma = world.gnss.sigma_gnss(fix[None])
-        if has_fix[0]:
-            sigma_gnss = sigma[0]
-        else:  # the model sees no fix where the receiver has one: trust its reported accuracy
-            h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
-            sigma_gnss = np.diag([h * h / 2, h * h / 2, v * v])
-    relative = relative_observation(target)
+        sigma_gnss = sigma[0] if has_fix[0] else reported
+        if sigma_gnss is None:
+            fix = None
     sigma_relative = world.camera.covariance(relative) if relative is not None else None
-    if fix is None:
-        sigma_gnss = None
     return SupportMeasurement(name, fix, sigma_gnss, relative, sigma_relative)

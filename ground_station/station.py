@@ -219,24 +219,7 @@ class GroundStation:
         }
 
     def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
-        scn = self.scenario
-        grid = self.world.map_grid()
-        g = LocalizabilityMap(grid, self.world.sigma0_map().sigma_m, scn.map, self.config.adaptive)
-        models = Models(
-            scn,
-            self.world,
-            waypoints["work"],
-            {n: w for n, w in waypoints.items() if n != "work"},
-            g,
-            SupportMpc(scn.control, grid, self.world.camera),
-            np.random.default_rng(self.config.seed),
-        )
-        state = StationState(
-            xhat=waypoints["work"][0].copy(),
-            yhat={n: w[0].copy() for n, w in models.support_waypoints.items()},
-            k=min(1, len(waypoints["work"]) - 1),
-        )
-        return models, state
+        return build_models(self.world, waypoints, self.config.adaptive, self.config.seed)
 
     def _advance_clock(self) -> None:
         step = self.scenario.control.t_cont_s
@@ -355,3 +338,28 @@ def _acked(view: VehicleView, command: int) -> bool:
 
 def _round(v: np.ndarray) -> list[float]:
     return [round(float(x), 4) for x in v]
+
+
+def build_models(
+    world: World, waypoints: dict[str, np.ndarray], adaptive: bool, seed: int
+) -> tuple[Models, StationState]:
+    """Everything the control cycle needs, and the state at the start (vehicles at w_1)."""
+    scn = world.scenario
+    grid = world.map_grid()
+    g = LocalizabilityMap(grid, world.sigma0_map().sigma_m, scn.map, adaptive)
+    supports = {n: w for n, w in waypoints.items() if n != "work"}
+    models = Models(
+        scn,
+        world,
+        waypoints["work"],
+        supports,
+        g,
+        SupportMpc(scn.control, grid, world.camera),
+        np.random.default_rng(seed),
+    )
+    state = StationState(
+        xhat=waypoints["work"][0].copy(),
+        yhat={n: w[0].copy() for n, w in supports.items()},
+        k=min(1, len(waypoints["work"]) - 1),
+    )
+    return models, state

@@ -15,6 +15,7 @@ the solve, and the problem is solved once more if the solution's flags differ (M
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass
 
@@ -200,3 +201,35 @@ class SupportMpc:
         """Straight paths at d_max per step along +-x, +-y, +-z."""
         steps = np.arange(1, self.horizon + 1)[:, None] * self.control.d_max_support_m
         return [yhat + steps * direction for direction in np.vstack([np.eye(3), -np.eye(3)])]
+
+
+def support_cost_numpy(
+    path: np.ndarray,
+    yhat: np.ndarray,
+    targets: np.ndarray,
+    terminal: np.ndarray,
+    work: np.ndarray,
+    blocked: np.ndarray,
+    g_values: np.ndarray,
+    grid: VoxelGrid,
+    control: ControlSettings,
+) -> float:
+    """The same cost in numpy over the whole map (an independent check of the casadi model)."""
+    from ground_station.localizability import hermite_zero_slope
+
+    c = control
+    path = np.asarray(path, dtype=float).reshape(-1, 3)
+
+    def sq(a: np.ndarray) -> float:
+        return float(np.sum(np.asarray(a) ** 2))
+
+    cost = c.w_interval * sq(yhat - path[0])
+    cost += c.w_interval * sum(sq(b - a) for a, b in itertools.pairwise(path))
+    terminal_sq = sq(terminal - path[-1])
+    limit = c.d_max_support_m**2
+    cost += (c.w_interval if terminal_sq <= limit else c.w_penalty) * terminal_sq
+    cost += c.w_gnss * float(np.sum(hermite_zero_slope(g_values, grid, path)))
+    cost += c.w_waypoint * sq(path - targets)
+    weights = c.w_relative + blocked.astype(float) * (c.w_penalty - c.w_relative)
+    cost += float(np.sum(weights * np.sum((work - path) ** 2, axis=1)))
+    return cost

@@ -148,9 +148,92 @@ def _wait(queue: MessageQueue, match: Callable, timeout_s: float = 5.0) -> None:
     raise RuntimeError("benchmark peer stopped answering")
 
 
+def bench_ground_station(cycles: int = 160, scipy_problems: int = 5) -> list[BenchResult]:
+    """MPC solve times and cycle time over a detached Along run (AC); scipy vs casadi."""
+    import numpy as np
+
+    from ground_station.detached import run_detached
+    from mission.plan_files import read_plan
+    from mission.world import World
+
+    world = World.load("along")
+    plan = read_plan(world.scenario)
+    waypoints = {
+        "work": plan.work,
+        **{f"support-{n + 1}": plan.supports[n] for n in range(len(plan.supports))},
+    }
+    run = run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
+    solves = [p.solve_ms for o in run.outputs for p in o.support_plans.values()]
+    cycle = statistics.median(o.cycle_ms for o in run.outputs)
+    ratio = _scipy_over_casadi(world, plan, scipy_problems)
+    median, p95 = statistics.median(solves), float(np.percentile(solves, 95))
+    return [
+        BenchResult("support_mpc_solve_ms_median", median, "ms", "<= 5", median <= 5),
+        BenchResult("support_mpc_solve_ms_p95", p95, "ms", "<= 15", p95 <= 15),
+        BenchResult("gcs_cycle_ms_median", cycle, "ms", "<= 25", cycle <= 25),
+        BenchResult("scipy_over_casadi_ratio", ratio, "x", ">= 10", ratio >= 10),
+    ]
+
+
+def _scipy_over_casadi(world, plan, problems: int) -> float:
+    """Median time ratio SLSQP / IPOPT on the same support-MPC problems (optima within 1 cm)."""
+    import numpy as np
+    from scipy.optimize import minimize
+
+    from ground_station.support_mpc import SupportMpc, support_cost_numpy
+    from ground_station.work_mpc import predict_work
+
+    control = world.scenario.control
+    grid = world.map_grid()
+    g = world.sigma0_map().sigma_m
+    mpc = SupportMpc(control, grid, world.camera)
+    ratios = []
+    u = control.horizon_steps
+    for i in range(problems):
+        yhat = plan.supports[0][i] + np.array([0.3, -0.2, 0.1])
+        work = predict_work(
+            plan.work[i],
+            i + 1,
+            plan.work,
+            control.horizon_steps,
+            control.d_max_work_m,
+            control.arrival_tol_m,
+        )
+        start = time.perf_counter()
+        result = mpc.solve(
+            yhat, plan.supports[0], work.path, work.indices, g, world.camera.observable
+        )
+        casadi_s = time.perf_counter() - start
+        targets, terminal = plan.supports[0][work.indices[:u]], plan.supports[0][work.indices[u]]
+
+        def cost(x, targets=targets, terminal=terminal, work=work, result=result, yhat=yhat):
+            return support_cost_numpy(
+                x, yhat, targets, terminal, work.path[:u], result.blocked, g, grid, control
+            )
+
+        def steps_left(x, yhat=yhat):
+            v = x.reshape(-1, 3)
+            steps = np.vstack([v[0] - yhat, np.diff(v, axis=0)])
+            return control.d_max_support_m**2 - np.sum(steps**2, axis=1)
+
+        start = time.perf_counter()
+        reference = minimize(
+            cost,
+            mpc._initial_guess(yhat, terminal, None).ravel(),
+            method="SLSQP",
+            options={"maxiter": 300, "ftol": 1e-12},
+            constraints=[{"type": "ineq", "fun": steps_left}],
+        )
+        scipy_s = time.perf_counter() - start
+        if np.max(np.abs(reference.x.reshape(-1, 3) - result.path)) <= 0.01:
+            ratios.append(scipy_s / casadi_s)
+    return statistics.median(ratios) if ratios else float("nan")
+
+
 BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "world": bench_sigma0_map,
     "vehicle": bench_vehicle,
+    "gcs": bench_ground_station,
 }
 
 

@@ -59,7 +59,7 @@ def build_parser() -> OneLineArgumentParser:
     bench.add_argument(
         "--only",
         action="append",
-        choices=["world", "vehicle"],
+        choices=["world", "vehicle", "gcs"],
         help="run only this group (repeatable)",
     )
 

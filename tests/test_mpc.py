@@ -93,3 +93,40 @@ def test_with_g_raised_around_the_uav_the_plan_leaves_the_region(setting):
     inside = np.all((positions >= lo) & (positions <= hi), axis=1)
     assert not inside[3:].any(), f"still inside after 3 cycles: {inside}"
     assert np.all(steps <= setting[0].scenario.control.d_max_support_m + 0.05)
+
+
+def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
+    """The casadi model equals an independent numpy cost; SLSQP finds the same optimum."""
+    from scipy.optimize import minimize
+
+    from ground_station.support_mpc import support_cost_numpy
+
+    world, plan, grid, mpc = setting
+    control = world.scenario.control
+    g = world.sigma0_map().sigma_m
+    yhat = plan.supports[0][3] + np.array([0.3, -0.2, 0.1])
+    work = predict_work(plan.work[3], 4, plan.work, 5, control.d_max_work_m, control.arrival_tol_m)
+    result = mpc.solve(yhat, plan.supports[0], work.path, work.indices, g, world.camera.observable)
+    targets, terminal = plan.supports[0][work.indices[:5]], plan.supports[0][work.indices[5]]
+
+    def cost(x):
+        return support_cost_numpy(
+            x, yhat, targets, terminal, work.path[:5], result.blocked, g, grid, control
+        )
+
+    def steps_left(x):
+        v = x.reshape(-1, 3)
+        steps = np.vstack([v[0] - yhat, np.diff(v, axis=0)])
+        return control.d_max_support_m**2 - np.sum(steps**2, axis=1)
+
+    start = mpc._initial_guess(yhat, terminal, None).ravel()
+    reference = minimize(
+        cost,
+        start,
+        method="SLSQP",
+        options={"maxiter": 300, "ftol": 1e-12},
+        constraints=[{"type": "ineq", "fun": steps_left}],
+    )
+    assert reference.success
+    np.testing.assert_allclose(reference.x.reshape(-1, 3), result.path, atol=0.01)
+    assert cost(result.path.ravel()) == pytest.approx(reference.fun, rel=1e-6)
