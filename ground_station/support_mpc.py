@@ -16,6 +16,7 @@ the solve, and the problem is solved once more if the solution's flags differ (M
 from __future__ import annotations
 
 import itertools
+import shutil
 import time
 from dataclasses import dataclass
 
@@ -37,6 +38,14 @@ IPOPT_OPTIONS = {
     "ipopt.warm_start_init_point": "yes",
     "ipopt.hessian_approximation": "limited-memory",
 }
+
+
+def jit_options() -> dict:
+    """Compile the NLP's functions with the system C compiler when there is one (~1.5x faster
+    solves for a second of compiling per run); interpret them otherwise."""
+    if shutil.which("gcc") is None:
+        return {}
+    return {"jit": True, "compiler": "shell", "jit_options": {"flags": ["-O2"]}}
 
 
 @dataclass(frozen=True)
@@ -121,7 +130,7 @@ class SupportMpc:
         # (the paper's penalty alone lets a discontinuous cost trap IPOPT beyond d_max).
         steps = [sq(v[:, 0] - yhat)] + [sq(v[:, u + 1] - v[:, u]) for u in range(horizon - 1)]
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": ca.vertcat(*steps)}
-        options = {**IPOPT_OPTIONS, "ipopt.hessian_approximation": self._hessian}
+        options = {**IPOPT_OPTIONS, "ipopt.hessian_approximation": self._hessian, **jit_options()}
         return ca.nlpsol("support_mpc", "ipopt", nlp, options)
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
