@@ -52,6 +52,9 @@ def build_parser() -> OneLineArgumentParser:
         help="where gcs.tlog, records.jsonl and g/ go (default logs/gcs-TIME)",
     )
     parser.add_argument(
+        "--tlog", type=Path, metavar="FILE", help="telemetry log (default: DIR/gcs.tlog)"
+    )
+    parser.add_argument(
         "--speedup", type=float, help="real time, this many times faster (default: lockstep)"
     )
     return parser
@@ -65,6 +68,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     world = World.load(args.scenario)
     scenario = world.scenario
     vehicles = _vehicle_addresses(args, scenario.task.supports)
+    if args.speedup is not None and not 0 < args.speedup <= 1000:
+        raise InputError("command line", "--speedup", "must be in (0, 1000]")
     waypoints = args.waypoints or Path(scenario.task.waypoints_dir)
     if not waypoints.is_dir():
         raise InputError("command line", "--waypoints", f"{waypoints} is not a directory")
@@ -76,6 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         out_dir=out,
         seed=args.seed,
         speedup=args.speedup,
+        tlog_path=args.tlog,
     )
     station = GroundStation(world, config)
     try:

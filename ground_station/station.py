@@ -48,6 +48,7 @@ class StationConfig:
     out_dir: Path
     seed: int = 0
     speedup: float | None = None  # None: lockstep
+    tlog_path: Path | None = None  # default: out_dir / "gcs.tlog"
     step_timeout_wall_s: float = 5.0
     connect_timeout_wall_s: float = 30.0
 
@@ -75,7 +76,7 @@ class GroundStation:
         self.endpoint = UdpEndpoint(MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID))
         self.queue = MessageQueue(self.endpoint)
         config.out_dir.mkdir(parents=True, exist_ok=True)
-        self.tlog = TlogWriter(config.out_dir / "gcs.tlog")
+        self.tlog = TlogWriter(config.tlog_path or config.out_dir / "gcs.tlog")
         self.records = (config.out_dir / "records.jsonl").open("w", encoding="utf-8")
         self.snapshots = config.out_dir / "g"
         self.snapshots.mkdir(exist_ok=True)

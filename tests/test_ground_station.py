@@ -47,19 +47,19 @@ def short_scenario(tmp_path_factory) -> Path:
 
 
 @contextlib.contextmanager
-def fleet(scenario: Path):
-    """Three supports, then the work UAV (sending them its truth), all in lockstep."""
+def fleet(scenario: Path, *pacing: str):
+    """Three supports, then the work UAV (sending them its truth); lockstep by default."""
     with (
-        vehicle_process("support-1", scenario=str(scenario), home=None) as s1,
-        vehicle_process("support-2", scenario=str(scenario), home=None) as s2,
-        vehicle_process("support-3", scenario=str(scenario), home=None) as s3,
+        vehicle_process("support-1", *pacing, scenario=str(scenario), home=None) as s1,
+        vehicle_process("support-2", *pacing, scenario=str(scenario), home=None) as s2,
+        vehicle_process("support-3", *pacing, scenario=str(scenario), home=None) as s3,
     ):
         truth = [a for s in (s1, s2, s3) for a in ("--truth-out", f"127.0.0.1:{s.truth_port}")]
-        with vehicle_process("work", *truth, scenario=str(scenario), home=None) as work:
+        with vehicle_process("work", *truth, *pacing, scenario=str(scenario), home=None) as work:
             yield {"work": work, "support-1": s1, "support-2": s2, "support-3": s3}
 
 
-def _run_station(scenario: Path, out: Path, method: str, vehicles) -> dict:
+def _run_station(scenario: Path, out: Path, method: str, vehicles, *extra: str) -> dict:
     addresses = ",".join(f"{n}=127.0.0.1:{v.port}" for n, v in vehicles.items())
     result = subprocess.run(
         [
@@ -76,6 +76,7 @@ def _run_station(scenario: Path, out: Path, method: str, vehicles) -> dict:
             str(out),
             "--seed",
             "1",
+            *extra,
         ],
         capture_output=True,
         text=True,
@@ -130,6 +131,23 @@ def test_mavlogdump_reads_the_tlog_and_nac_leaves_g(short_scenario, tmp_path):
     )
     assert result.returncode == 0, result.stderr
     assert result.stdout.count("SIM_STATE") >= summary["control_cycles"] * 4
+
+
+def test_real_time_mode_completes_too(short_scenario, tmp_path):
+    with fleet(short_scenario, "--speedup", "10") as vehicles:
+        summary = _run_station(
+            short_scenario,
+            tmp_path,
+            "ac",
+            vehicles,
+            "--speedup",
+            "10",
+            "--tlog",
+            str(tmp_path / "custom.tlog"),
+        )
+    assert summary["completed"] is True
+    assert (tmp_path / "custom.tlog").stat().st_size > 0
+    assert not (tmp_path / "gcs.tlog").exists()
 
 
 def test_sim_state_never_reaches_the_estimator(along, tmp_path):
