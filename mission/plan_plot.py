@@ -10,12 +10,11 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.collections import PolyCollection
-from matplotlib.patches import Rectangle
 
 from mission.atomic import write_atomically
 from mission.planner import Plan
 from mission.world import World
+from mission.world_plot import draw_background
 
 COLORS = ("tab:blue", "tab:green", "tab:purple", "tab:olive", "tab:cyan")
 
@@ -27,33 +26,8 @@ def plot_plan(world: World, plan: Plan, path: Path) -> None:
     for ax, (a, b, normal, title) in zip(axes, ((0, 1, 2, "top view"), (0, 2, 1, "side view"))):
         level = float(np.mean(plan.supports[:, :, normal]))
         k = int(sigma0.grid.index_of(np.full((1, 3), level))[0, normal])
-        values = np.take(sigma0.sigma_m, k, axis=normal)
-        lo = sigma0.grid.origin_m
-        hi = lo + sigma0.grid.voxel_m * np.array(sigma0.grid.shape)
-        image = ax.imshow(
-            values.T,
-            origin="lower",
-            extent=(lo[a], hi[a], lo[b], hi[b]),
-            cmap="RdYlGn_r",
-            interpolation="nearest",
-            alpha=0.6,
-            norm=matplotlib.colors.LogNorm(0.1, world.scenario.map.no_fix_sigma_m),
-        )
-        plt.colorbar(image, ax=ax, label="sigma_0 [m]", shrink=0.8)
-        triangles = world.structure.mesh.triangles[:, :, [a, b]]
-        ax.add_collection(PolyCollection(triangles, facecolor="0.5", edgecolor="none", alpha=0.2))
-        for zone in world.scenario.world.zones:
-            ax.add_patch(
-                Rectangle(
-                    (zone.min_m[a], zone.min_m[b]),
-                    zone.max_m[a] - zone.min_m[a],
-                    zone.max_m[b] - zone.min_m[b],
-                    fill=False,
-                    edgecolor="magenta",
-                    linewidth=2,
-                    label=f"zone {zone.name}",
-                )
-            )
+        point = np.full(3, level)
+        draw_background(ax, world, sigma0, point, a, b, normal, alpha=0.6)
         _path(ax, plan.work, a, b, "tab:red", "work UAV")
         for n, points in enumerate(plan.supports):
             _path(ax, points, a, b, COLORS[n % len(COLORS)], f"support {n + 1}")

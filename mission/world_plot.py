@@ -40,11 +40,19 @@ def plot_world(world: World, point: np.ndarray, path: Path) -> None:
     plt.close(fig)
 
 
-def _draw_slice(
-    ax, world: World, sigma0: Sigma0Map, point, a: int, b: int, normal: int, title: str
-) -> None:
+def draw_background(
+    ax,
+    world: World,
+    sigma0: Sigma0Map,
+    point: np.ndarray,
+    a: int,
+    b: int,
+    normal: int,
+    alpha: float = 1.0,
+) -> int:
+    """sigma_0 slice through ``point`` (axes a, b), the structure and the zones; the slice index."""
     grid = sigma0.grid
-    k = int(grid.index_of(point[None])[0, normal])
+    k = int(grid.index_of(np.asarray(point)[None])[0, normal])
     values = np.take(sigma0.sigma_m, k, axis=normal)
     if a > b:
         values = values.T
@@ -56,6 +64,7 @@ def _draw_slice(
         cmap="RdYlGn_r",
         norm=matplotlib.colors.LogNorm(vmin=0.1, vmax=world.scenario.map.no_fix_sigma_m),
         interpolation="nearest",
+        alpha=alpha,
     )
     plt.colorbar(image, ax=ax, label="sigma_0 [m]", shrink=0.8)
     triangles = world.structure.mesh.triangles[:, :, [a, b]]
@@ -72,6 +81,14 @@ def _draw_slice(
                 label=f"zone {zone.name}",
             )
         )
+    return k
+
+
+def _draw_slice(
+    ax, world: World, sigma0: Sigma0Map, point, a: int, b: int, normal: int, title: str
+) -> None:
+    grid = sigma0.grid
+    k = draw_background(ax, world, sigma0, point, a, b, normal)
     ax.plot(point[a], point[b], "k*", markersize=12, label="sky-plot point")
     axis = "xyz"
     ax.set_xlabel(f"{axis[a]} [m]")
