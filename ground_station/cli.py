@@ -8,7 +8,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from mission.cli_common import OneLineArgumentParser, run_guarded
+from mission.cli_common import OneLineArgumentParser, die_with_parent, run_guarded
 from mission.errors import InputError
 from mission.mavlink_udp import parse_address
 from mission.plan_files import vehicle_names
@@ -52,6 +52,11 @@ def build_parser() -> OneLineArgumentParser:
         help="where gcs.tlog, records.jsonl and g/ go (default logs/gcs-TIME)",
     )
     parser.add_argument(
+        "--exit-with-parent",
+        action="store_true",
+        help="stop when the process that started this one dies",
+    )
+    parser.add_argument(
         "--tlog", type=Path, metavar="FILE", help="telemetry log (default: DIR/gcs.tlog)"
     )
     parser.add_argument(
@@ -65,6 +70,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     from ground_station.station import GroundStation, StationConfig, StationError
 
     args = build_parser().parse_args(argv)
+    if args.exit_with_parent:
+        die_with_parent()
     world = World.load(args.scenario)
     scenario = world.scenario
     vehicles = _vehicle_addresses(args, scenario.task.supports)

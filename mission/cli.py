@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -63,8 +64,15 @@ def build_parser() -> OneLineArgumentParser:
         help="run only this group (repeatable)",
     )
 
-    run = commands.add_parser("run", help="run a mission (for now: the scenario's world summary)")
+    run = commands.add_parser("run", help="run a mission: vehicle processes + ground station")
     run.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
+    run.add_argument("--method", choices=["ac", "nac"], default="ac")
+    run.add_argument("--seed", type=int, default=0)
+    run.add_argument(
+        "--out", type=Path, metavar="DIR", help="default logs/<scenario>-<method>-<seed>-<time>/"
+    )
+    run.add_argument("--realtime", action="store_true", help="real time instead of lockstep")
+    run.add_argument("--speedup", type=float, default=1.0, help="with --realtime (default 1)")
     return parser
 
 
@@ -103,11 +111,37 @@ def _world(args) -> int:
 
 
 def _run(args) -> int:
-    from mission.world_report import summary_text
+    import time
 
-    world = World.load(args.scenario)
-    print(summary_text(world))
-    print("\nThe mission runner (vehicles + ground station) is not built yet; see issue 6.")
+    from mission.orchestrator import RunFailed, RunOptions, run_mission
+    from mission.scenario import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    if args.realtime and not 0 < args.speedup <= 1000:
+        raise InputError("command line", "--speedup", "must be in (0, 1000]")
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
+    options = RunOptions(
+        args.scenario, args.method, args.seed, out, args.speedup if args.realtime else None
+    )
+    print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
+    try:
+        summary = run_mission(options, scenario)
+    except RunFailed as error:
+        print(f"run failed: {error}; logs kept in {out}", file=sys.stderr)
+        return 1
+    error = summary["work_error_m"]
+    done = (
+        f"completed at {summary['completion_time_s']:.1f} s"
+        if summary["completed"]
+        else f"NOT completed within {scenario.run.timeout_s:g} s"
+    )
+    print(
+        f"{done}; {summary['control_cycles']} cycles; steps in multipath "
+        f"{summary['multipath_steps_total']} {summary['multipath_steps']}; work UAV error "
+        f"mean {error['mean']} m; wall {summary['wall_time_s']:.1f} s, real-time factor "
+        f"{summary['realtime_factor']}; summary in {out / 'summary.json'}"
+    )
     return 0
 
 
@@ -123,16 +157,22 @@ def _plan(args) -> int:
     out = args.out if args.out is not None else Path(world.scenario.task.waypoints_dir)
     for path in write_plan(plan, world.scenario, out):
         print(f"wrote {path}")
-    along, segment = place_along(plan, world.workspace)
-    wall = place_wall(plan, world.workspace)
-    print(
-        f"an Along zone for this plan (segment w_1,{segment + 1} -> w_1,{segment + 2}): "
-        f"min_m {list(along.min_m)}, max_m {list(along.max_m)}"
-    )
-    print(
-        f"a Wall zone for this plan (around w_1,6): min_m {list(wall.min_m)}, "
-        f"max_m {list(wall.max_m)}"
-    )
+    try:
+        along, segment = place_along(plan, world.workspace)
+        print(
+            f"an Along zone for this plan (segment w_1,{segment + 1} -> w_1,{segment + 2}): "
+            f"min_m {list(along.min_m)}, max_m {list(along.max_m)}"
+        )
+    except ValueError as reason:
+        print(f"an Along zone: {reason}")
+    try:
+        wall = place_wall(plan, world.workspace)
+        print(
+            f"a Wall zone for this plan (around w_1,6): min_m {list(wall.min_m)}, "
+            f"max_m {list(wall.max_m)}"
+        )
+    except (ValueError, IndexError):
+        print("a Wall zone: no place on this plan")
     if args.plot is not None:
         from mission.plan_plot import plot_plan
 

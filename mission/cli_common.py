@@ -39,3 +39,14 @@ def parse_point(values: Sequence[float], flag: str) -> tuple[float, float, float
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise InputError("command line", flag, "expects three finite numbers X Y Z")
     return float(values[0]), float(values[1]), float(values[2])
+
+
+def die_with_parent() -> None:
+    """Ask Linux to send SIGTERM when the parent process dies (no orphans); no-op elsewhere."""
+    import contextlib
+    import ctypes
+    import signal
+
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)

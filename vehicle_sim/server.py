@@ -13,13 +13,10 @@ Each step ends with SYSTEM_TIME (the step marker the ground station waits for).
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
 import math
 import os
 import select
 import signal
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -271,7 +268,7 @@ def install_signal_handlers(stop: Callable[..., None], die_with_parent: bool) ->
     """SIGTERM and SIGINT end the loop cleanly; optionally die with the parent (Linux)."""
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGINT, stop)
-    if die_with_parent and sys.platform.startswith("linux"):
-        with contextlib.suppress(OSError, AttributeError):
-            libc = ctypes.CDLL("libc.so.6", use_errno=True)
-            libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    if die_with_parent:
+        from mission.cli_common import die_with_parent as arrange
+
+        arrange()

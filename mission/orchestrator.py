@@ -1,0 +1,179 @@
+"""``mission run``: one process per vehicle and a ground station, on free loopback ports.
+
+Children write their stderr to ``DIR/<name>.log``; all of them are stopped when the run ends,
+fails, or is interrupted, and die with this process if it is killed (``--exit-with-parent``).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mission.analysis import analyze_tlog, mpc_stats
+from mission.atomic import write_text_atomically
+from mission.plan_files import vehicle_names
+from mission.settings import Scenario
+
+_BANNER = re.compile(r"listening on [\d.]+:(\d+)(?:, truth port (\d+))?")
+BANNER_TIMEOUT_S = 60.0
+
+
+class RunFailed(RuntimeError):
+    """A child process died or a run could not start; names the process."""
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What to run and where."""
+
+    scenario: str
+    method: str
+    seed: int
+    out_dir: Path
+    speedup: float | None = None
+
+
+@dataclass
+class Child:
+    """A started child process and its log."""
+
+    name: str
+    process: subprocess.Popen
+    log: Path
+
+
+def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
+    """Run a mission to completion or timeout; return its summary (also in summary.json)."""
+    options.out_dir.mkdir(parents=True, exist_ok=True)
+    children: list[Child] = []
+    start = time.monotonic()
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        pacing = ["--speedup", str(options.speedup)] if options.speedup else []
+        common = [
+            "--scenario",
+            options.scenario,
+            "--seed",
+            str(options.seed),
+            *pacing,
+            "--exit-with-parent",
+        ]
+        names = vehicle_names(scenario.task.supports)
+        ports: dict[str, int] = {}
+        truth_ports: list[int] = []
+        for name in names[1:]:
+            child = _start(
+                options.out_dir,
+                name,
+                ["-m", "vehicle_sim", "--vehicle", name, "--port", "0", *common],
+            )
+            children.append(child)
+            port, truth = _wait_banner(child)
+            ports[name] = port
+            truth_ports.append(truth)
+        truth_out = [a for p in truth_ports for a in ("--truth-out", f"127.0.0.1:{p}")]
+        work = _start(
+            options.out_dir,
+            "work",
+            ["-m", "vehicle_sim", "--vehicle", "work", "--port", "0", *truth_out, *common],
+        )
+        children.append(work)
+        ports["work"], _ = _wait_banner(work)
+        addresses = ",".join(f"{n}=127.0.0.1:{ports[n]}" for n in names)
+        gcs = _start(
+            options.out_dir,
+            "ground_station",
+            [
+                "-m",
+                "ground_station",
+                "--method",
+                options.method,
+                "--vehicles",
+                addresses,
+                "--out",
+                str(options.out_dir),
+                *common,
+            ],
+        )
+        children.append(gcs)
+        _supervise(gcs, children, required={"work"})
+        if gcs.process.returncode != 0:
+            raise RunFailed(
+                f"ground_station exited with status {gcs.process.returncode} (see {gcs.log})"
+            )
+    finally:
+        _stop_all(children)
+        signal.signal(signal.SIGTERM, previous)
+    wall = time.monotonic() - start
+    summary = {
+        "scenario": scenario.name,
+        "method": options.method,
+        "seed": options.seed,
+        **analyze_tlog(options.out_dir / "gcs.tlog", scenario),
+    }
+    simulated = (summary["control_cycles"] or 0) * scenario.control.t_cont_s
+    summary["wall_time_s"] = round(wall, 3)
+    summary["realtime_factor"] = round(simulated / wall, 3) if wall > 0 else None
+    summary["mpc_solve_ms"] = mpc_stats(options.out_dir / "records.jsonl")
+    write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
+    return summary
+
+
+def _raise_interrupt(*_: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def _start(out_dir: Path, name: str, arguments: list[str]) -> Child:
+    log = out_dir / f"{name}.log"
+    handle = log.open("w")
+    process = subprocess.Popen(
+        [sys.executable, *arguments], stdout=handle, stderr=handle, stdin=subprocess.DEVNULL
+    )
+    handle.close()
+    return Child(name, process, log)
+
+
+def _wait_banner(child: Child) -> tuple[int, int | None]:
+    deadline = time.monotonic() + BANNER_TIMEOUT_S
+    while time.monotonic() < deadline:
+        match = _BANNER.search(child.log.read_text())
+        if match:
+            return int(match.group(1)), int(match.group(2)) if match.group(2) else None
+        if child.process.poll() is not None:
+            break
+        time.sleep(0.05)
+    tail = child.log.read_text().strip().splitlines()[-1:] or ["no output"]
+    raise RunFailed(f"{child.name} did not start: {tail[0]}")
+
+
+def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
+    """Wait for the ground station; a dead required vehicle ends the run with an error."""
+    while gcs.process.poll() is None:
+        for child in children:
+            if child is gcs or child.process.poll() is None:
+                continue
+            if child.name in required:
+                raise RunFailed(
+                    f"{child.name} died (exit status {child.process.returncode}, see {child.log})"
+                )
+        time.sleep(0.1)
+
+
+def _stop_all(children: list[Child]) -> None:
+    for child in children:
+        if child.process.poll() is None:
+            child.process.terminate()
+    deadline = time.monotonic() + 10
+    for child in children:
+        try:
+            child.process.wait(timeout=max(0.1, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            child.process.kill()
+            child.process.wait()
