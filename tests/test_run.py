@@ -1,0 +1,107 @@
+"""``mission run``: a short mission end to end, teardown, failure of a vehicle, determinism."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tests.processes import ROOT
+
+SHORT = """
+extends: along
+name: short-run
+task:
+  work_waypoints_m: [[-6.0, -3.0, 7.0], [-3.0, -3.0, 7.0], [0.0, -3.0, 7.0]]
+  waypoints_dir: plan
+run: {timeout_s: 120.0}
+world:
+  zones:
+    - {name: test, min_m: [-14.0, -12.0, 5.0], max_m: [-4.0, -6.0, 11.0], offset_m: [1.0, 0, 0]}
+"""
+VOLATILE = {"wall_time_s", "realtime_factor", "mpc_solve_ms"}
+
+
+@pytest.fixture(scope="module")
+def scenario(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("run") / "short-run.yaml"
+    path.write_text(SHORT)
+    subprocess.run(
+        [sys.executable, "-m", "mission", "plan", str(path)],
+        check=True,
+        capture_output=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    return path
+
+
+def _children_of(scenario: Path) -> list[str]:
+    found = subprocess.run(["pgrep", "-f", "--", str(scenario)], capture_output=True, text=True)
+    return found.stdout.split()
+
+
+def _run(scenario: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out), *extra],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
+
+
+def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path):
+    result = _run(scenario, tmp_path / "a", "--seed", "2")
+    assert result.returncode == 0, result.stderr
+    assert "completed at" in result.stdout
+    summary = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert summary["completed"] is True and summary["method"] == "ac" and summary["seed"] == 2
+    assert 10 < summary["completion_time_s"] < 120
+    assert summary["control_cycles"] == round(summary["completion_time_s"] / 0.5)
+    assert set(summary["multipath_steps"]) == {"support-1", "support-2", "support-3"}
+    assert summary["multipath_steps_total"] == sum(summary["multipath_steps"].values())
+    assert 0 < summary["work_error_m"]["mean"] < 1.0
+    assert summary["mpc_solve_ms"]["median"] > 0
+    assert (tmp_path / "a" / "gcs.tlog").stat().st_size > 0
+    assert _children_of(scenario) == []
+
+    again = _run(scenario, tmp_path / "b", "--seed", "2")
+    assert again.returncode == 0, again.stderr
+    second = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert {k: v for k, v in summary.items() if k not in VOLATILE} == {
+        k: v for k, v in second.items() if k not in VOLATILE
+    }
+
+
+def test_a_dead_work_vehicle_ends_the_run_with_a_clear_error(scenario, tmp_path):
+    out = tmp_path / "killed"
+    run = subprocess.Popen(
+        [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (out / "gcs.tlog").exists():
+            time.sleep(0.1)
+        time.sleep(1.0)
+        work = subprocess.run(
+            ["pgrep", "-f", "--", f"--vehicle work .*{scenario}"], capture_output=True, text=True
+        ).stdout.split()
+        assert work, "the work vehicle is running"
+        subprocess.run(["kill", "-9", *work], check=True)
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    assert run.returncode == 1
+    assert "work died" in stderr and "logs kept" in stderr
+    assert (out / "gcs.tlog").exists() and (out / "work.log").exists()
+    assert _children_of(scenario) == []
