@@ -15,8 +15,10 @@ the solve, and the problem is solved once more if the solution's flags differ (M
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import shutil
+import tempfile
 import time
 from dataclasses import dataclass
 
@@ -40,12 +42,18 @@ IPOPT_OPTIONS = {
 }
 
 
-def jit_options() -> dict:
+def jit_options(directory: str) -> dict:
     """Compile the NLP's functions with the system C compiler when there is one (~1.5x faster
-    solves for a second of compiling per run); interpret them otherwise."""
+    solves for a second of compiling per run); interpret them otherwise. Generated files stay
+    in ``directory``."""
     if shutil.which("gcc") is None:
         return {}
-    return {"jit": True, "compiler": "shell", "jit_options": {"flags": ["-O2"]}}
+    return {
+        "jit": True,
+        "compiler": "shell",
+        "jit_cleanup": False,
+        "jit_options": {"flags": ["-O2"], "directory": directory, "cleanup": False},
+    }
 
 
 @dataclass(frozen=True)
@@ -90,6 +98,9 @@ class SupportMpc:
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
         self._hessian = hessian
         self.symbolic = symbolic
+        self._build_dir = tempfile.TemporaryDirectory(
+            prefix="support-mpc-", ignore_cleanup_errors=True
+        )
         self._solver = self._build()
 
     def _build(self):
@@ -130,8 +141,13 @@ class SupportMpc:
         # (the paper's penalty alone lets a discontinuous cost trap IPOPT beyond d_max).
         steps = [sq(v[:, 0] - yhat)] + [sq(v[:, u + 1] - v[:, u]) for u in range(horizon - 1)]
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": ca.vertcat(*steps)}
-        options = {**IPOPT_OPTIONS, "ipopt.hessian_approximation": self._hessian, **jit_options()}
-        return ca.nlpsol("support_mpc", "ipopt", nlp, options)
+        options = {
+            **IPOPT_OPTIONS,
+            "ipopt.hessian_approximation": self._hessian,
+            **jit_options(self._build_dir.name),
+        }
+        with contextlib.chdir(self._build_dir.name):  # casadi writes its C file to the cwd
+            return ca.nlpsol("support_mpc", "ipopt", nlp, options)
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(corner of the window in world coordinates, its values first-axis-fastest)."""

@@ -130,3 +130,12 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
     assert reference.success
     np.testing.assert_allclose(reference.x.reshape(-1, 3), result.path, atol=0.01)
     assert cost(result.path.ravel()) == pytest.approx(reference.fun, rel=1e-6)
+
+
+def test_building_the_mpc_leaves_no_files_in_the_working_directory(
+    along_world, tmp_path, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    mpc = SupportMpc(along_world.scenario.control, along_world.map_grid(), along_world.camera)
+    assert mpc.horizon == 5
+    assert list(tmp_path.iterdir()) == []
