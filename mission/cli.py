@@ -55,6 +55,10 @@ def build_parser() -> OneLineArgumentParser:
     )
     plan.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the plan")
 
+    analyze = commands.add_parser("analyze", help="recompute a run's metrics from its tlog")
+    analyze.add_argument("run", type=Path, metavar="DIR|TLOG")
+    analyze.add_argument("--scenario", help="scenario of the run (default: from summary.json)")
+
     bench = commands.add_parser("bench", help="run the benchmarks and print their medians")
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument(
@@ -85,6 +89,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _run(args)
     if args.command == "bench":
         return _bench(args)
+    if args.command == "analyze":
+        return _analyze(args)
     if args.command == "plan":
         return _plan(args)
     raise AssertionError(args.command)
@@ -177,6 +183,28 @@ def _plan(args) -> int:
         from mission.plan_plot import plot_plan
 
         plot_plan(world, plan, args.plot)
+    return 0
+
+
+def _analyze(args) -> int:
+    from mission.analysis import analyze_tlog
+    from mission.scenario import load_scenario
+
+    tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
+    if not tlog.is_file():
+        raise InputError(str(args.run), "", "no gcs.tlog here (give a run directory or a tlog)")
+    summary_path = tlog.parent / "summary.json"
+    previous = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
+    scenario_name = args.scenario or previous.get("scenario_source") or previous.get("scenario")
+    if scenario_name is None:
+        raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
+    metrics = analyze_tlog(tlog, load_scenario(scenario_name))
+    merged = {**previous, **metrics}
+    if previous:
+        from mission.atomic import write_text_atomically
+
+        write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
+    print(json.dumps(metrics))
     return 0
 
 

@@ -114,6 +114,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     wall = time.monotonic() - start
     summary = {
         "scenario": scenario.name,
+        "scenario_source": scenario.source,
         "method": options.method,
         "seed": options.seed,
         **analyze_tlog(options.out_dir / "gcs.tlog", scenario),

@@ -23,7 +23,7 @@ world:
   zones:
     - {name: test, min_m: [-14.0, -12.0, 5.0], max_m: [-4.0, -6.0, 11.0], offset_m: [1.0, 0, 0]}
 """
-VOLATILE = {"wall_time_s", "realtime_factor", "mpc_solve_ms"}
+VOLATILE = {"wall_time_s", "realtime_factor", "mpc_solve_ms"}  # wall-clock figures
 
 
 @pytest.fixture(scope="module")
@@ -69,6 +69,17 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert summary["mpc_solve_ms"]["median"] > 0
     assert (tmp_path / "a" / "gcs.tlog").stat().st_size > 0
     assert _children_of(scenario) == []
+    analyzed = subprocess.run(
+        [sys.executable, "-m", "mission", "analyze", str(tmp_path / "a")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    assert analyzed.returncode == 0, analyzed.stderr
+    metrics = json.loads(analyzed.stdout)
+    assert metrics == {k: summary[k] for k in metrics}, "the tlog alone gives the same metrics"
+    assert summary["scenario_source"] == str(scenario)
 
     again = _run(scenario, tmp_path / "b", "--seed", "2")
     assert again.returncode == 0, again.stderr
