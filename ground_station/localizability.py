@@ -106,24 +106,3 @@ def casadi_smoothed(grid: VoxelGrid) -> ca.Function:
     u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
     warped = ca.vertcat(*(warped_index(u[a], upper[a]) for a in range(3)))
     return ca.Function("G_s", [x, values], [table(warped, values)])
-
-
-def casadi_smoothed_sx(grid: VoxelGrid) -> ca.Function:
-    """G_s as a pure-SX expression (hat-function weights per axis, contracted separably).
-
-    Mathematically the same multilinear interpolation at warped indices as
-    :func:`casadi_smoothed`, but expandable into an SX graph, which IPOPT evaluates several
-    times faster; meant for the small windows the support MPC uses.
-    """
-    nx, ny, nz = grid.shape
-    x = ca.SX.sym("x", 3)
-    values = ca.SX.sym("values", grid.n_voxels)
-    upper = np.array(grid.shape, dtype=float) - 1
-    u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
-    hats = []
-    for axis, n in enumerate(grid.shape):
-        w = warped_index(u[axis], upper[axis])
-        hats.append(ca.vertcat(*(ca.fmax(0, 1 - ca.fabs(w - i)) for i in range(n))))
-    along_x = ca.mtimes(hats[0].T, ca.reshape(values, nx, ny * nz))
-    plane = ca.reshape(along_x, ny, nz)
-    return ca.Function("G_s", [x, values], [ca.mtimes([hats[1].T, plane, hats[2]])])

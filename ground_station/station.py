@@ -25,7 +25,7 @@ from ground_station.tlog import TlogWriter
 from mission.frames import GeodeticFrame, enu_to_ned
 from mission.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.vehicle_identity import VehicleIdentity
-from mission.waypoints import read_waypoints
+from mission.waypoints import read_waypoints, row_position_enu
 from mission.world import World
 
 GCS_SYSTEM_ID = 255
@@ -138,8 +138,6 @@ class GroundStation:
 
     def upload_missions(self) -> dict[str, np.ndarray]:
         """Upload each vehicle's waypoint file; return their waypoints (ENU, home excluded)."""
-        from mission.waypoints import row_position_enu
-
         waypoints = {}
         for view in self.views.values():
             rows = read_waypoints(self.config.waypoints_dir / f"{view.name}.waypoints")

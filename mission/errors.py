@@ -25,3 +25,13 @@ class FieldProblem(ValueError):
         self.field = field
         self.problem = problem
         super().__init__(f"{field}: {problem}")
+
+
+def read_text_file(path, error: type[InputError] = InputError) -> str:
+    """A UTF-8 text file's contents; unreadable or binary files raise ``error`` naming it."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as failure:
+        raise error(str(path), "", f"cannot read: {failure.strerror}") from None
+    except UnicodeDecodeError:
+        raise error(str(path), "", "not UTF-8 text") from None

@@ -14,7 +14,7 @@ from typing import Any
 
 import yaml
 
-from mission.errors import FieldProblem, ScenarioError
+from mission.errors import FieldProblem, ScenarioError, read_text_file
 from mission.settings import Scenario
 from mission.settings_build import build_settings
 
@@ -88,12 +88,7 @@ def _load_layers(path: Path, depth: int) -> dict[str, Any]:
 
 def read_yaml_mapping(path: Path) -> dict[str, Any]:
     """Parse a YAML file that must hold a mapping; errors name the file, line and column."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise ScenarioError(str(path), "", f"cannot read: {error.strerror}") from None
-    except UnicodeDecodeError:
-        raise ScenarioError(str(path), "", "not UTF-8 text") from None
+    text = read_text_file(path, ScenarioError)
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as error:

@@ -14,7 +14,7 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.atomic import write_text_atomically
-from mission.errors import InputError
+from mission.errors import InputError, read_text_file
 from mission.frames import GeodeticFrame
 from mission.mission_items import GLOBAL_FRAMES, MissionItem, float32_decimal
 
@@ -129,12 +129,7 @@ def write_waypoints(path: Path, rows: list[WaypointRow]) -> None:
 def read_waypoints(path: Path) -> list[WaypointRow]:
     """Read a QGC WPL 110 file; errors name the file, line and column."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise InputError(str(path), "", f"cannot read: {error.strerror}") from None
-    except UnicodeDecodeError:
-        raise InputError(str(path), "", "not UTF-8 text") from None
+    text = read_text_file(path)
     lines = text.splitlines()
     if not lines or lines[0].strip() != HEADER:
         raise InputError(str(path), "line 1", f"first line must be '{HEADER}'")

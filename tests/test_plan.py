@@ -183,3 +183,12 @@ def test_malformed_waypoint_files_name_file_line_and_column(tmp_path, case, text
         read_waypoints(path)
     message = str(caught.value)
     assert str(path) in message and where in message and problem in message
+
+
+def test_binary_and_missing_waypoint_files_are_reported(tmp_path):
+    binary = tmp_path / "binary.waypoints"
+    binary.write_bytes(b"\xff\xfe\x00QGC")
+    with pytest.raises(InputError, match=r"binary\.waypoints: not UTF-8 text"):
+        read_waypoints(binary)
+    with pytest.raises(InputError, match=r"absent\.waypoints: cannot read"):
+        read_waypoints(tmp_path / "absent.waypoints")

@@ -19,7 +19,7 @@ import select
 import signal
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from mission.mavlink_udp import Address, UdpEndpoint
@@ -46,7 +46,6 @@ class ServerStats:
 
     auto_steps: int = 0
     truth_waits_timed_out: int = 0
-    peers_seen: set[Address] = field(default_factory=set)
 
 
 class VehicleServer:
@@ -153,7 +152,6 @@ class VehicleServer:
         if message.get_srcSystem() == vehicle.identity.system_id:
             return  # our own echo (e.g. through a mirror)
         self.peers[sender] = now
-        self.stats.peers_seen.add(sender)
         if message.get_type() == "SYSTEM_TIME":
             if self.clock.lockstep:
                 self._on_tick(message.time_boot_ms / 1000.0, now)
