@@ -106,3 +106,15 @@ def casadi_smoothed(grid: VoxelGrid) -> ca.Function:
     u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
     warped = ca.vertcat(*(warped_index(u[a], upper[a]) for a in range(3)))
     return ca.Function("G_s", [x, values], [table(warped, values)])
+
+
+def casadi_smoothed_constant(grid: VoxelGrid, values: np.ndarray) -> ca.Function:
+    """The same zero-slope Hermite field for fixed values (e.g. sigma_0): x (3) -> value."""
+    axes = [list(np.arange(n, dtype=float)) for n in grid.shape]
+    data = np.asarray(values, dtype=float).reshape(grid.shape).ravel(order="F")
+    table = ca.interpolant("sigma0", "linear", axes, data)
+    x = ca.MX.sym("x", 3)
+    upper = np.array(grid.shape, dtype=float) - 1
+    u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
+    warped = ca.vertcat(*(warped_index(u[a], upper[a]) for a in range(3)))
+    return ca.Function("sigma0_s", [x], [table(warped)])

@@ -353,7 +353,7 @@ def build_models(
         waypoints["work"],
         supports,
         g,
-        SupportMpc(scn.control, grid, world.camera),
+        SupportMpc(scn.control, grid, world.camera, g.initial),
         np.random.default_rng(seed),
     )
     state = StationState(

@@ -25,7 +25,11 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ground_station.localizability import casadi_smoothed
+from ground_station.localizability import (
+    casadi_smoothed,
+    casadi_smoothed_constant,
+    hermite_zero_slope,
+)
 from mission.camera import CameraModel
 from mission.grid import VoxelGrid
 from mission.settings import ControlSettings
@@ -65,6 +69,7 @@ class SupportPlan:
     solve_ms: float
     blocked: np.ndarray
     resolved: bool
+    anchors: np.ndarray
 
     @property
     def command(self) -> np.ndarray:
@@ -85,10 +90,14 @@ class SupportMpc:
         control: ControlSettings,
         grid: VoxelGrid,
         camera: CameraModel,
+        sigma0: np.ndarray | None = None,
     ) -> None:
         self.control = control
         self.grid = grid
         self.camera = camera
+        self.sigma0 = (
+            None if sigma0 is None else np.asarray(sigma0, dtype=float).reshape(grid.shape)
+        )
         self.horizon = control.horizon_steps
         reach = control.horizon_steps * control.d_max_support_m + grid.voxel_m
         half = int(np.ceil(reach / grid.voxel_m))
@@ -98,16 +107,27 @@ class SupportMpc:
             prefix="support-mpc-", ignore_cleanup_errors=True
         )
         self._solver = self._build()
+        cube = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=3)))
+        cube = cube[np.any(cube != 0, axis=1)]
+        self._directions = cube / np.linalg.norm(cube, axis=1, keepdims=True)
+        reach = control.horizon_steps * control.d_max_support_m
+        self._shell_radii = np.arange(0.5, reach + 1e-9, 0.5)
+        steps = np.full(self.horizon, control.d_max_support_m**2 * (1 + 1e-6))
+        shadow = np.full(0 if sigma0 is None else self.horizon, control.support_max_sigma0_m)
+        self._upper_bounds = np.concatenate([steps, shadow])
 
     def _build(self):
         c, horizon = self.control, self.horizon
         sym = ca.MX
         g_s = casadi_smoothed(self._window_grid)
+        if self.sigma0 is not None:
+            prior_sigma = casadi_smoothed_constant(self.grid, self.sigma0)
         v = sym.sym("v", 3, horizon)
         yhat = sym.sym("yhat", 3)
         targets = sym.sym("w", 3, horizon)
         terminal = sym.sym("terminal", 3)
         work = sym.sym("vw", 3, horizon)
+        anchors = sym.sym("q", 3, horizon)  # where a blocked step is pulled (see _anchors)
         blocked = sym.sym("blocked", horizon)
         values = sym.sym("G", self._window_grid.n_voxels)
         corner = sym.sym("corner", 3)
@@ -125,18 +145,22 @@ class SupportMpc:
         for u in range(horizon):
             cost += c.w_gnss * g_s(v[:, u] - corner, values)
             cost += c.w_waypoint * sq(v[:, u] - targets[:, u])
-            weight = c.w_relative + blocked[u] * (c.w_penalty - c.w_relative)
-            cost += weight * sq(work[:, u] - v[:, u])
+            cost += (1 - blocked[u]) * c.w_relative * sq(work[:, u] - v[:, u])
+            cost += blocked[u] * c.w_penalty * sq(anchors[:, u] - v[:, u])
             if u + 1 < horizon:
                 cost += c.w_interval * sq(v[:, u + 1] - v[:, u])
         cost += xi(sq(terminal - v[:, horizon - 1]))
         parameters = ca.vertcat(
-            yhat, ca.vec(targets), terminal, ca.vec(work), blocked, corner, values
+            yhat, ca.vec(targets), terminal, ca.vec(work), ca.vec(anchors), blocked, corner, values
         )
         # The vehicle cannot fly faster than s_max: each predicted step is also bounded hard
         # (the paper's penalty alone lets a discontinuous cost trap IPOPT beyond d_max).
         steps = [sq(v[:, 0] - yhat)] + [sq(v[:, u + 1] - v[:, u]) for u in range(horizon - 1)]
-        nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": ca.vertcat(*steps)}
+        # Stay where the prior map (structure and sky, no zones) predicts a usable fix: the
+        # paper's LOS penalty pulls a blocked support straight at the work UAV, i.e. under the
+        # deck, where it would lose its fix (and fly into the structure).
+        shadow = [] if self.sigma0 is None else [prior_sigma(v[:, u]) for u in range(horizon)]
+        nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": ca.vertcat(*steps, *shadow)}
         options = {
             **IPOPT_OPTIONS,
             **jit_options(self._build_dir.name),
@@ -173,26 +197,28 @@ class SupportMpc:
         targets = support_waypoints[work_indices[:horizon]]
         terminal = support_waypoints[work_indices[horizon]]
         work = work_path[:horizon]
+        corner, window = self.window_of(yhat, g_values)
+        fixed = np.concatenate([yhat, targets.ravel(), terminal, work.ravel()])
         guess = self._initial_guess(yhat, terminal, warm_start)
-        blocked = ~observable(guess, work)
         start = time.perf_counter()
-        path, status, cost = self._solve_once(
-            yhat, targets, terminal, work, blocked, g_values, guess
-        )
+        blocked = ~observable(guess, work)
+        anchors = self.anchors(guess, work, targets, blocked)
+        flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window])
+        path, status, cost = self._solve_once(fixed, flags, guess)
         if escape:  # G_s is flat at voxel centres: also start from paths leaving each way
             for candidate in self._escape_guesses(yhat):
-                tried = self._solve_once(
-                    yhat, targets, terminal, work, blocked, g_values, candidate
-                )
+                tried = self._solve_once(fixed, flags, candidate)
                 if tried[2] < cost - 1e-9:
                     path, status, cost = tried
         resolved = False
         after = ~observable(path, work)
         if np.any(after != blocked):
-            path, status, _ = self._solve_once(yhat, targets, terminal, work, after, g_values, path)
             blocked, resolved = after, True
+            anchors = self.anchors(path, work, targets, blocked)
+            flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window])
+            path, status, _ = self._solve_once(fixed, flags, path)
         elapsed = (time.perf_counter() - start) * 1000
-        return SupportPlan(path, status, elapsed, blocked, resolved)
+        return SupportPlan(path, status, elapsed, blocked, resolved, anchors)
 
     def _initial_guess(
         self, yhat: np.ndarray, terminal: np.ndarray, warm_start: np.ndarray | None
@@ -202,20 +228,46 @@ class SupportMpc:
         fractions = np.arange(1, self.horizon + 1)[:, None] / (self.horizon + 1)
         return yhat + (terminal - yhat) * fractions
 
-    def _solve_once(self, yhat, targets, terminal, work, blocked, g_values, guess):
-        corner, window = self.window_of(yhat, g_values)
-        parameters = np.concatenate(
-            [yhat, targets.ravel(), terminal, work.ravel(), blocked.astype(float), corner, window]
-        )
+    def _solve_once(self, fixed: np.ndarray, flags: np.ndarray, guess: np.ndarray):
         result = self._solver(
             x0=guess.ravel(),
-            p=parameters,
+            p=np.concatenate([fixed, flags]),
             lbg=-np.inf,
-            ubg=self.control.d_max_support_m**2 * (1 + 1e-6),
+            ubg=self._upper_bounds,
         )
         status = self._solver.stats()["return_status"]
         path = np.array(result["x"]).reshape(self.horizon, 3)
         return path, status, float(result["f"])
+
+    def anchors(
+        self, guess: np.ndarray, work: np.ndarray, targets: np.ndarray, blocked: np.ndarray
+    ) -> np.ndarray:
+        """Where the LOS penalty pulls each blocked step.
+
+        ``paper``: the work UAV itself. ``visible-point``: the nearest point around the step's
+        guess (26 directions, shells up to the horizon's reach) that sees the work UAV and has
+        a usable prior fix, the nearest to the work UAV among equals; the pre-planned waypoint
+        when there is none.
+        """
+        anchors = np.array(work, dtype=float)
+        if self.control.los_penalty == "paper" or not np.any(blocked):
+            return anchors
+        for u in np.flatnonzero(blocked):
+            anchors[u] = self._nearest_visible(guess[u], work[u], targets[u])
+        return anchors
+
+    def _nearest_visible(self, start: np.ndarray, work: np.ndarray, fallback: np.ndarray):
+        for radius in self._shell_radii:
+            points = start + radius * self._directions
+            if self.sigma0 is not None:
+                usable = hermite_zero_slope(self.sigma0, self.grid, points)
+                points = points[usable <= self.control.support_max_sigma0_m]
+            if len(points) == 0:
+                continue
+            seen = points[self.camera.observable(points, work[None])]
+            if len(seen):
+                return seen[np.argmin(np.linalg.norm(seen - work, axis=1))]
+        return fallback
 
     def _escape_guesses(self, yhat: np.ndarray) -> list[np.ndarray]:
         """Straight paths at d_max per step along +-x, +-y, +-z."""
@@ -233,10 +285,10 @@ def support_cost_numpy(
     g_values: np.ndarray,
     grid: VoxelGrid,
     control: ControlSettings,
+    anchors: np.ndarray | None = None,
 ) -> float:
-    """The same cost in numpy over the whole map (an independent check of the casadi model)."""
-    from ground_station.localizability import hermite_zero_slope
-
+    """The same cost in numpy over the whole map (an independent check of the casadi model);
+    ``anchors`` default to the work UAV's path (the paper's penalty)."""
     c = control
     path = np.asarray(path, dtype=float).reshape(-1, 3)
 
@@ -250,6 +302,8 @@ def support_cost_numpy(
     cost += (c.w_interval if terminal_sq <= limit else c.w_penalty) * terminal_sq
     cost += c.w_gnss * float(np.sum(hermite_zero_slope(g_values, grid, path)))
     cost += c.w_waypoint * sq(path - targets)
-    weights = c.w_relative + blocked.astype(float) * (c.w_penalty - c.w_relative)
-    cost += float(np.sum(weights * np.sum((work - path) ** 2, axis=1)))
+    anchors = work if anchors is None else anchors
+    free = ~np.asarray(blocked, dtype=bool)
+    cost += c.w_relative * float(np.sum((work - path)[free] ** 2))
+    cost += c.w_penalty * float(np.sum((anchors - path)[~free] ** 2))
     return cost

@@ -208,7 +208,16 @@ def _scipy_over_casadi(world, plan, problems: int) -> float:
 
         def cost(x, targets=targets, terminal=terminal, work=work, result=result, yhat=yhat):
             return support_cost_numpy(
-                x, yhat, targets, terminal, work.path[:u], result.blocked, g, grid, control
+                x,
+                yhat,
+                targets,
+                terminal,
+                work.path[:u],
+                result.blocked,
+                g,
+                grid,
+                control,
+                result.anchors,
             )
 
         def steps_left(x, yhat=yhat):

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from datetime import datetime
+from typing import Literal
 
 from mission.errors import FieldProblem
 
@@ -253,11 +254,13 @@ class ControlSettings:
     w_relative: float
     w_penalty: float
     arrival_tol_m: float
+    support_max_sigma0_m: float
+    los_penalty: Literal["visible-point", "paper"]
 
     def __post_init__(self) -> None:
         _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
         _positive(self, "t_pred_s", "t_cont_s", "s_max_work_m_s", "s_max_support_m_s")
-        _positive(self, "arrival_tol_m")
+        _positive(self, "arrival_tol_m", "support_max_sigma0_m")
         _non_negative(self, "w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")
 
     @property

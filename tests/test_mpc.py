@@ -111,7 +111,16 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
 
     def cost(x):
         return support_cost_numpy(
-            x, yhat, targets, terminal, work.path[:5], result.blocked, g, grid, control
+            x,
+            yhat,
+            targets,
+            terminal,
+            work.path[:5],
+            result.blocked,
+            g,
+            grid,
+            control,
+            result.anchors,
         )
 
     def steps_left(x):
@@ -139,3 +148,64 @@ def test_building_the_mpc_leaves_no_files_in_the_working_directory(
     mpc = SupportMpc(along_world.scenario.control, along_world.map_grid(), along_world.camera)
     assert mpc.horizon == 5
     assert list(tmp_path.iterdir()) == []
+
+
+def _blocked_case(world, mpc: SupportMpc):
+    """A support above the deck's edge, the work UAV hovering under the deck: no sight line."""
+    yhat = np.array([0.0, 6.0, 10.0])
+    work = np.array([0.0, -3.0, 7.0])
+    horizon = mpc.horizon
+    waypoints = np.repeat(yhat[None], 2, axis=0)
+    assert not world.camera.observable(yhat[None], work[None])[0]
+    g = world.sigma0_map().sigma_m
+    warm, plan = None, None
+    for _ in range(4):  # a few cycles, warm-started, the work UAV holding still
+        plan = mpc.solve(
+            yhat,
+            waypoints,
+            np.repeat(work[None], horizon + 1, axis=0),
+            np.ones(horizon + 1, dtype=int),
+            g,
+            world.camera.observable,
+            warm,
+        )
+        yhat, warm = plan.path[0], plan.path
+    return plan, work
+
+
+def _with_control(world, **changes) -> SupportMpc:
+    from dataclasses import replace
+
+    control = replace(world.scenario.control, **changes)
+    sigma0 = world.sigma0_map().sigma_m if control.support_max_sigma0_m < 1e6 else None
+    return SupportMpc(control, world.map_grid(), world.camera, sigma0)
+
+
+def test_los_penalty_brings_a_blocked_support_back_into_sight(along_world):
+    mpc = _with_control(along_world, los_penalty="visible-point")
+    plan, work = _blocked_case(along_world, mpc)
+    # The commanded first steps see it (later ones head back to the blocked terminal waypoint).
+    assert along_world.camera.observable(plan.path[:2], work[None]).all()
+    sigma0 = along_world.sigma0_map().sigma_m.reshape(along_world.map_grid().shape)
+    usable = hermite_zero_slope(sigma0, along_world.map_grid(), plan.path)
+    assert np.all(usable <= along_world.scenario.control.support_max_sigma0_m + 1e-3)
+
+
+def test_the_papers_penalty_form_pulls_toward_the_work_uav_not_into_sight(along_world):
+    """w_penalty |v_w - v|^2 is smallest straight above the work UAV, on the deck: blocked."""
+    mpc = _with_control(along_world, los_penalty="paper")
+    plan, work = _blocked_case(along_world, mpc)
+    assert not along_world.camera.observable(plan.path[-1:], work[None])[0]
+    assert np.linalg.norm(plan.path[-1] - work) < np.linalg.norm([0.0, 9.0, 3.0]) - 2.0
+
+
+def test_supports_stay_out_of_the_structures_gnss_shadow(along_world):
+    grid = along_world.map_grid()
+    sigma0 = along_world.sigma0_map().sigma_m.reshape(grid.shape)
+    limit = along_world.scenario.control.support_max_sigma0_m
+    kept_out, _ = _blocked_case(along_world, _with_control(along_world, los_penalty="paper"))
+    assert np.all(hermite_zero_slope(sigma0, grid, kept_out.path) <= limit + 1e-3)
+    free, _ = _blocked_case(
+        along_world, _with_control(along_world, los_penalty="paper", support_max_sigma0_m=1e9)
+    )
+    assert np.max(hermite_zero_slope(sigma0, grid, free.path)) > limit  # into the deck
