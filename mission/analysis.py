@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 from collections import defaultdict
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -26,15 +27,32 @@ from mission.world import World
 GCS_SYSTEM_ID = 255
 
 
-def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
-    """The tlog-determined metrics of summary.json."""
-    world = World(scenario)
+@dataclass
+class RunTrace:
+    """What a ground station's tlog says about a run, in simulated seconds."""
+
+    truth: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    estimates: dict[float, np.ndarray] = field(default_factory=dict)
+    ticks: set[float] = field(default_factory=set)
+    completion: float | None = None
+
+    @property
+    def supports(self) -> list[int]:
+        """System ids of the support vehicles (the work UAV is system 1)."""
+        return sorted({s for s, _ in self.truth if s != 1})
+
+    def track(self, system: int) -> tuple[np.ndarray, np.ndarray]:
+        """(times, positions) of one vehicle's truth."""
+        times = sorted(t for s, t in self.truth if s == system)
+        points = [self.truth[(system, t)] for t in times]
+        return np.array(times), np.array(points).reshape(-1, 3)
+
+
+def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
+    """Truth (SIM_STATE), the work UAV's estimates, clock ticks and completion from a tlog."""
     frame = GeodeticFrame(scenario.world.anchor)
     epoch = scenario.run.epoch_unix_s
-    truth: dict[tuple[int, float], np.ndarray] = {}
-    estimates: dict[float, np.ndarray] = {}
-    ticks: set[float] = set()
-    completion = None
+    trace = RunTrace()
     pending_estimate: tuple[float, np.ndarray] | None = None
     log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega", robust_parsing=True)
     while (message := log.recv_match()) is not None:
@@ -42,38 +60,58 @@ def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
         t = round(message._timestamp - epoch, 3)
         source = message.get_srcSystem()
         if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
-            truth[(source, t)] = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
+            trace.truth[(source, t)] = frame.from_degE7(
+                message.lat_int, message.lon_int, message.alt
+            )
         elif source != GCS_SYSTEM_ID:
             continue
         elif kind == "VISION_POSITION_ESTIMATE":
             pending_estimate = (t, ned_to_enu(np.array([message.x, message.y, message.z])))
         elif kind == "SET_POSITION_TARGET_LOCAL_NED":
             if pending_estimate is not None and message.target_system == 1:
-                estimates[pending_estimate[0]] = pending_estimate[1]
+                trace.estimates[pending_estimate[0]] = pending_estimate[1]
             pending_estimate = None
         elif kind == "SYSTEM_TIME" and message.time_boot_ms > 0:
-            ticks.add(round(message.time_boot_ms / 1000.0, 3))
-        elif kind == "STATUSTEXT" and "Mission complete" in message.text and completion is None:
-            completion = t
-    supports = sorted({s for s, _ in truth if s != 1})
-    steps = defaultdict(int)
-    for t in sorted(ticks):
-        for system in supports:
-            position = truth.get((system, t))
+            trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
+        elif kind == "STATUSTEXT" and "Mission complete" in message.text:
+            trace.completion = t if trace.completion is None else trace.completion
+    return trace
+
+
+def zone_steps(trace: RunTrace, world: World) -> dict[int, list[float]]:
+    """Per support system id, the clock ticks at which its truth was inside a zone."""
+    steps: dict[int, list[float]] = defaultdict(list)
+    for t in sorted(trace.ticks):
+        for system in trace.supports:
+            position = trace.truth.get((system, t))
             if position is not None and world.in_zone(position[None])[0]:
-                steps[f"support-{system - 1}"] += 1
-    errors = [
-        float(np.linalg.norm(x - truth[(1, t)]))
-        for t, x in sorted(estimates.items())
-        if (1, t) in truth
+                steps[system].append(t)
+    return steps
+
+
+def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
+    """(times, |xhat - x|) of the work UAV at every cycle with both."""
+    pairs = [
+        (t, float(np.linalg.norm(x - trace.truth[(1, t)])))
+        for t, x in sorted(trace.estimates.items())
+        if (1, t) in trace.truth
     ]
+    return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+
+
+def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
+    """The tlog-determined metrics of summary.json."""
+    trace = read_tlog(tlog, scenario)
+    steps = zone_steps(trace, World(scenario))
+    _, errors = work_errors(trace)
+    counts = {f"support-{s - 1}": len(steps.get(s, [])) for s in trace.supports}
     return {
-        "completed": completion is not None,
-        "completion_time_s": completion,
-        "control_cycles": len(estimates),
-        "multipath_steps": {f"support-{s - 1}": steps[f"support-{s - 1}"] for s in supports},
-        "multipath_steps_total": int(sum(steps.values())),
-        "work_error_m": _stats(errors),
+        "completed": trace.completion is not None,
+        "completion_time_s": trace.completion,
+        "control_cycles": len(trace.estimates),
+        "multipath_steps": counts,
+        "multipath_steps_total": int(sum(counts.values())),
+        "work_error_m": _stats([float(e) for e in errors]),
     }
 
 

@@ -239,10 +239,37 @@ def _scipy_over_casadi(world, plan, problems: int) -> float:
     return statistics.median(ratios) if ratios else float("nan")
 
 
+def bench_runs(trials: int = 15, jobs: int = 2) -> list[BenchResult]:
+    """One lockstep run per scenario and method: Along AC's real-time factor and the wall time
+    of the full Table 3 batch estimated as trials x (sum of the four runs' walls) / jobs."""
+    import tempfile
+    from pathlib import Path
+
+    from mission.orchestrator import RunOptions, run_mission
+    from mission.scenario import load_scenario
+
+    walls, along_ac = [], float("nan")
+    with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
+        for name in ("along", "wall"):
+            scenario = load_scenario(name)
+            for method in ("ac", "nac"):
+                out = Path(temp) / f"{name}-{method}"
+                summary = run_mission(RunOptions(name, method, 0, out), scenario)
+                walls.append(summary["wall_time_s"])
+                if (name, method) == ("along", "ac"):
+                    along_ac = summary["realtime_factor"]
+    estimate = trials * sum(walls) / jobs
+    return [
+        BenchResult("realtime_factor_lockstep", along_ac, "x", ">= 30", along_ac >= 30),
+        BenchResult("table3_wall_s_estimate", estimate, "s", "<= 600", estimate <= 600),
+    ]
+
+
 BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "world": bench_sigma0_map,
     "vehicle": bench_vehicle,
     "gcs": bench_ground_station,
+    "run": bench_runs,
 }
 
 

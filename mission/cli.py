@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from collections.abc import Sequence
@@ -58,13 +59,16 @@ def build_parser() -> OneLineArgumentParser:
     analyze = commands.add_parser("analyze", help="recompute a run's metrics from its tlog")
     analyze.add_argument("run", type=Path, metavar="DIR|TLOG")
     analyze.add_argument("--scenario", help="scenario of the run (default: from summary.json)")
+    analyze.add_argument(
+        "--plots", action="store_true", help="draw the paper's figures into DIR/plots/"
+    )
 
     bench = commands.add_parser("bench", help="run the benchmarks and print their medians")
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument(
         "--only",
         action="append",
-        choices=["world", "vehicle", "gcs"],
+        choices=["world", "vehicle", "gcs", "run"],
         help="run only this group (repeatable)",
     )
 
@@ -77,6 +81,18 @@ def build_parser() -> OneLineArgumentParser:
     )
     run.add_argument("--realtime", action="store_true", help="real time instead of lockstep")
     run.add_argument("--speedup", type=float, default=1.0, help="with --realtime (default 1)")
+    run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
+
+    batch = commands.add_parser(
+        "batch", help="run scenarios x methods x seeds in parallel; write Table 3"
+    )
+    batch.add_argument("scenarios", nargs="*", default=["along", "wall"], metavar="SCENARIO")
+    batch.add_argument("--trials", type=int, default=15, help="seeds 0..N-1 (default 15)")
+    batch.add_argument("--methods", default="ac,nac", help="comma-separated (default ac,nac)")
+    batch.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
+    batch.add_argument(
+        "--out", type=Path, default=Path("logs/batch"), help="default logs/batch (resumable)"
+    )
     return parser
 
 
@@ -93,6 +109,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _analyze(args)
     if args.command == "plan":
         return _plan(args)
+    if args.command == "batch":
+        return _batch(args)
     raise AssertionError(args.command)
 
 
@@ -122,6 +140,10 @@ def _run(args) -> int:
     from mission.orchestrator import RunFailed, RunOptions, run_mission
     from mission.scenario import load_scenario
 
+    if args.exit_with_parent:
+        from mission.cli_common import die_with_parent
+
+        die_with_parent()
     scenario = load_scenario(args.scenario)
     if args.realtime and not 0 < args.speedup <= 1000:
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
@@ -149,6 +171,36 @@ def _run(args) -> int:
         f"{summary['realtime_factor']}; summary in {out / 'summary.json'}"
     )
     return 0
+
+
+def _batch(args) -> int:
+    from mission.batch import BatchOptions, Trial, run_batch
+    from mission.scenario import load_scenario
+
+    if not 1 <= args.trials <= 1000:
+        raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
+    if not 1 <= args.jobs <= 64:
+        raise InputError("command line", "--jobs", f"must be in [1, 64], got {args.jobs}")
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    if not methods or any(m not in ("ac", "nac") for m in methods):
+        raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
+    names = [load_scenario(s).name for s in args.scenarios]
+    if len(set(names)) != len(names):
+        raise InputError("command line", "SCENARIO", f"the same scenario twice: {names}")
+    trials = [
+        Trial(scenario, name, method, seed)
+        for scenario, name in zip(args.scenarios, names)
+        for method in methods
+        for seed in range(args.trials)
+    ]
+    result = run_batch(BatchOptions(trials, args.out, args.jobs))
+    print((args.out / "table.md").read_text(), end="")
+    print(
+        f"{result['finished']} runs finished, {result['skipped']} already done, "
+        f"{len(result['failed'])} failed; wall {result['wall_time_s']:.1f} s; "
+        f"results in {args.out}"
+    )
+    return 1 if result["failed"] else 0
 
 
 def _plan(args) -> int:
@@ -198,13 +250,21 @@ def _analyze(args) -> int:
     scenario_name = args.scenario or previous.get("scenario_source") or previous.get("scenario")
     if scenario_name is None:
         raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
-    metrics = analyze_tlog(tlog, load_scenario(scenario_name))
+    scenario = load_scenario(scenario_name)
+    metrics = analyze_tlog(tlog, scenario)
     merged = {**previous, **metrics}
     if previous:
         from mission.atomic import write_text_atomically
 
         write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
     print(json.dumps(metrics))
+    if args.plots:
+        from mission.analysis import read_tlog
+        from mission.run_plot import plot_run
+
+        trace = read_tlog(tlog, scenario)
+        for path in plot_run(trace, World(scenario), tlog.parent / "g", tlog.parent / "plots"):
+            print(f"wrote {path}")
     return 0
 
 

@@ -49,6 +49,7 @@ def draw_background(
     b: int,
     normal: int,
     alpha: float = 1.0,
+    label: str = "sigma_0 [m]",
 ) -> int:
     """sigma_0 slice through ``point`` (axes a, b), the structure and the zones; the slice index."""
     grid = sigma0.grid
@@ -66,7 +67,7 @@ def draw_background(
         interpolation="nearest",
         alpha=alpha,
     )
-    plt.colorbar(image, ax=ax, label="sigma_0 [m]", shrink=0.8)
+    plt.colorbar(image, ax=ax, label=label, shrink=0.8)
     triangles = world.structure.mesh.triangles[:, :, [a, b]]
     ax.add_collection(PolyCollection(triangles, facecolor="0.55", edgecolor="none", alpha=0.25))
     for zone in world.scenario.world.zones:

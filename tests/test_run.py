@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import struct
 import subprocess
 import sys
 import time
@@ -70,14 +71,22 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert (tmp_path / "a" / "gcs.tlog").stat().st_size > 0
     assert _children_of(scenario) == []
     analyzed = subprocess.run(
-        [sys.executable, "-m", "mission", "analyze", str(tmp_path / "a")],
+        [sys.executable, "-m", "mission", "analyze", str(tmp_path / "a"), "--plots"],
         capture_output=True,
         text=True,
         timeout=300,
         cwd=ROOT,
     )
     assert analyzed.returncode == 0, analyzed.stderr
-    metrics = json.loads(analyzed.stdout)
+    metrics = json.loads(analyzed.stdout.splitlines()[0])
+    for name, size in [
+        ("trajectories", (1500, 1100)),
+        ("error", (1100, 400)),
+        ("g_update", (1600, 900)),
+    ]:
+        header = (tmp_path / "a" / "plots" / f"{name}.png").read_bytes()[:24]
+        assert header[:8] == b"\x89PNG\r\n\x1a\n"
+        assert struct.unpack(">II", header[16:24]) == size
     assert metrics == {k: summary[k] for k in metrics}, "the tlog alone gives the same metrics"
     assert summary["scenario_source"] == str(scenario)
 
