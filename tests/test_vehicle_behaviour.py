@@ -130,7 +130,7 @@ def test_failsafe_holds_after_the_set_time_and_clears(frame):
     with vehicle_process("support-1", home=tuple(home)) as vehicle:
         client = MavClient(vehicle.address)
         client.arm_guided(2)
-        client.setpoint(2, home + np.array([50.0, 0.0, 0.0]))
+        client.setpoint(2, home + np.array([20.0, 0.0, 0.0]))
         texts = []
         positions = []
         for k in range(1, 9):  # no setpoint after t = 0: failsafe after 2 s (scenario default)
@@ -141,7 +141,7 @@ def test_failsafe_holds_after_the_set_time_and_clears(frame):
         assert fired == [5], texts  # checked at the start of the step after 2.0 s
         assert np.linalg.norm(positions[-1] - positions[4]) < QUANTUM_M, "holds position"
         heartbeat = last(client.seen, "HEARTBEAT")
-        client.setpoint(2, home + np.array([50.0, 0.0, 0.0]))
+        client.setpoint(2, home + np.array([20.0, 0.0, 0.0]))
         messages = client.step_to(STEP_MS * 9)
         moved = truth_of(last(messages, "SIM_STATE"), frame)
         client.close()
@@ -202,3 +202,32 @@ def test_commands_are_acknowledged(frame):
         sync = client.wait_for("TIMESYNC", 3.0)
         assert sync.ts1 == 123456 and sync.tc1 > 0
         client.close()
+
+
+@pytest.mark.parametrize(
+    ("target", "reason"),
+    [
+        ((30.0, -10.0, 7.0), "outside workspace"),
+        ((0.0, 0.0, 8.5), "inside structure"),
+        ((0.0, 0.0, 9.5), "crosses structure"),  # on the deck, reached only through it
+    ],
+)
+def test_geofence_refuses_setpoints_and_the_vehicle_holds(frame, target, reason):
+    home = np.array([0.0, -10.0, 7.0])
+    with vehicle_process("support-1", home=tuple(home)) as vehicle:
+        client = MavClient(vehicle.address)
+        client.arm_guided(2)
+        client.setpoint(2, home + np.array([0.0, -3.0, 0.0]))  # moving away from the bridge
+        moving = truth_of(last(client.step_to(STEP_MS), "SIM_STATE"), frame)
+        client.setpoint(2, np.array(target))
+        messages = client.step_to(2 * STEP_MS)
+        for k in range(3, 6):
+            messages += client.step_to(STEP_MS * k)
+        held = truth_of(last(messages, "SIM_STATE"), frame)
+        client.setpoint(2, home + np.array([3.0, 0.0, 0.0]))  # a good setpoint is taken again
+        after = truth_of(last(client.step_to(6 * STEP_MS), "SIM_STATE"), frame)
+        client.close()
+    texts = [m.text for m in messages if m.get_type() == "STATUSTEXT"]
+    assert f"Setpoint rejected: fence: {reason}" in texts, texts
+    assert np.linalg.norm(held - moving) < QUANTUM_M, "stops where it was told to leave the fence"
+    assert np.linalg.norm(after - held) == pytest.approx(0.5, abs=QUANTUM_M)

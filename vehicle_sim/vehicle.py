@@ -290,12 +290,17 @@ class Vehicle:
 
     def _on_setpoint(self, msg: Any) -> None:
         problem = self._setpoint_problem(msg)
+        target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
+        if problem is None:
+            problem = self._geofence_problem(target)
+            if problem is not None:  # a guided vehicle told to leave the fence stops there
+                self.kinematics.hold()
         if problem is not None:
             category, detail = problem
             self.counters.reject(f"setpoint: {category}")
             self._warn_once(f"Setpoint rejected: {detail}")
             return
-        self.kinematics.target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
+        self.kinematics.target = target
         self._last_setpoint_s = self.sim_time_s
         if self.failsafe:
             self.failsafe = False
@@ -314,6 +319,23 @@ class Vehicle:
             return "out of range", "position out of range"
         if not self.armed or self.mode != modes.GUIDED:
             return "not guided", "not armed in GUIDED"
+        return None
+
+    def _geofence_problem(self, target: np.ndarray) -> tuple[str, str] | None:
+        """Targets outside the workspace, inside the structure, or reached only through it."""
+        if not self.world.in_workspace(target[None])[0]:
+            return "geofence", "fence: outside workspace"
+        structure = self.world.structure
+        if structure is None:
+            return None
+        if structure.contains(target[None])[0]:
+            return "geofence", "fence: inside structure"
+        start = self.kinematics.believed  # the autopilot fences in its own navigation frame
+        if (
+            np.linalg.norm(target - start) > 0
+            and structure.segments_blocked(start[None], target[None])[0]
+        ):
+            return "geofence", "fence: crosses structure"
         return None
 
     def _warn_once(self, text: str) -> None:
