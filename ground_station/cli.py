@@ -12,6 +12,7 @@ from mission.cli_common import OneLineArgumentParser, die_with_parent, run_guard
 from mission.errors import InputError
 from mission.mavlink_udp import parse_address
 from mission.plan_files import vehicle_names
+from mission.signing import read_signing_key
 from mission.vehicle_identity import BASE_PORT, VehicleIdentity
 from mission.world import World
 
@@ -62,6 +63,12 @@ def build_parser() -> OneLineArgumentParser:
     parser.add_argument(
         "--speedup", type=float, help="real time, this many times faster (default: lockstep)"
     )
+    parser.add_argument(
+        "--signing-key",
+        type=Path,
+        metavar="FILE",
+        help="MAVLink 2 signing: 32-byte secret (raw or 64 hex digits)",
+    )
     return parser
 
 
@@ -89,6 +96,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         seed=args.seed,
         speedup=args.speedup,
         tlog_path=args.tlog,
+        signing_key=read_signing_key(args.signing_key) if args.signing_key else None,
     )
     station = GroundStation(world, config)
     try:

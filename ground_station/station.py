@@ -49,6 +49,7 @@ class StationConfig:
     seed: int = 0
     speedup: float | None = None  # None: lockstep
     tlog_path: Path | None = None  # default: out_dir / "gcs.tlog"
+    signing_key: bytes | None = None  # MAVLink 2 signing secret
     step_timeout_wall_s: float = 5.0
     connect_timeout_wall_s: float = 30.0
 
@@ -73,7 +74,9 @@ class GroundStation:
         self.scenario = world.scenario
         self.config = config
         self.frame = GeodeticFrame(self.scenario.world.anchor)
-        self.endpoint = UdpEndpoint(MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID))
+        self.endpoint = UdpEndpoint(
+            MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID, config.signing_key)
+        )
         self.queue = MessageQueue(self.endpoint)
         config.out_dir.mkdir(parents=True, exist_ok=True)
         self.tlog = TlogWriter(config.tlog_path or config.out_dir / "gcs.tlog")

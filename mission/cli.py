@@ -81,6 +81,14 @@ def build_parser() -> OneLineArgumentParser:
     )
     run.add_argument("--realtime", action="store_true", help="real time instead of lockstep")
     run.add_argument("--speedup", type=float, default=1.0, help="with --realtime (default 1)")
+    run.add_argument(
+        "--signing-key", type=Path, metavar="FILE", help="sign every link (32-byte secret)"
+    )
+    run.add_argument(
+        "--observer",
+        metavar="HOST:PORT",
+        help="every vehicle also streams here (QGroundControl, MAVProxy); use with --realtime",
+    )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
     batch = commands.add_parser(
@@ -149,8 +157,25 @@ def _run(args) -> int:
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
+    if args.signing_key is not None:
+        from mission.signing import read_signing_key
+
+        read_signing_key(args.signing_key)  # a bad key fails here, before anything starts
+    if args.observer is not None:
+        from mission.mavlink_udp import parse_address
+
+        try:
+            parse_address(args.observer, "--observer")
+        except ValueError as error:
+            raise InputError("command line", "--observer", str(error)) from None
     options = RunOptions(
-        args.scenario, args.method, args.seed, out, args.speedup if args.realtime else None
+        args.scenario,
+        args.method,
+        args.seed,
+        out,
+        args.speedup if args.realtime else None,
+        args.signing_key.resolve() if args.signing_key else None,
+        args.observer,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     try:

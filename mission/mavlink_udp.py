@@ -12,6 +12,8 @@ from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.signing import enable_signing, signing_rejections
+
 Address = tuple[str, int]
 MAX_DATAGRAM = 65_535
 MAX_BATCH_BYTES = 1_400  # stay below a typical path MTU
@@ -46,9 +48,17 @@ class LinkCounters:
 class MavlinkCodec:
     """One MAVLink 2 identity (sysid, compid): packs outgoing and parses incoming datagrams."""
 
-    def __init__(self, system_id: int, component_id: int) -> None:
+    def __init__(self, system_id: int, component_id: int, signing_key: bytes | None = None) -> None:
         self.mav = mavlink2.MAVLink(None, srcSystem=system_id, srcComponent=component_id)
         self.mav.robust_parsing = True
+        self.signed = signing_key is not None
+        if signing_key is not None:
+            enable_signing(self.mav, signing_key)
+
+    @property
+    def signature_rejections(self) -> int:
+        """Packets refused for a missing or wrong signature (0 without signing)."""
+        return signing_rejections(self.mav) if self.signed else 0
 
     @property
     def system_id(self) -> int:
@@ -120,7 +130,14 @@ class UdpEndpoint:
             except OSError:  # e.g. ICMP port unreachable surfaced on Linux
                 continue
             self.counters.datagrams_in += 1
+            refused = self.codec.signature_rejections
             messages, bad = self.codec.decode(datagram)
+            refused = self.codec.signature_rejections - refused
+            if refused:  # a refused packet parses as bad data: count it as refused instead
+                self.counters.rejected["signature"] = (
+                    self.counters.rejected.get("signature", 0) + refused
+                )
+                bad -= refused
             if bad:
                 self.counters.bad_datagrams += 1
                 self.counters.bad_packets += bad

@@ -38,6 +38,8 @@ class RunOptions:
     seed: int
     out_dir: Path
     speedup: float | None = None
+    signing_key: Path | None = None  # the key file, passed to every process
+    observer: str | None = None  # HOST:PORT every vehicle also streams to
 
 
 @dataclass
@@ -57,6 +59,9 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     previous = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         pacing = ["--speedup", str(options.speedup)] if options.speedup else []
+        if options.signing_key is not None:
+            pacing += ["--signing-key", str(options.signing_key)]
+        observer = ["--out", options.observer] if options.observer else []
         common = [
             "--scenario",
             options.scenario,
@@ -72,7 +77,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
             child = _start(
                 options.out_dir,
                 name,
-                ["-m", "vehicle_sim", "--vehicle", name, "--port", "0", *common],
+                ["-m", "vehicle_sim", "--vehicle", name, "--port", "0", *observer, *common],
             )
             children.append(child)
             port, truth = _wait_banner(child)
@@ -82,7 +87,17 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         work = _start(
             options.out_dir,
             "work",
-            ["-m", "vehicle_sim", "--vehicle", "work", "--port", "0", *truth_out, *common],
+            [
+                "-m",
+                "vehicle_sim",
+                "--vehicle",
+                "work",
+                "--port",
+                "0",
+                *truth_out,
+                *observer,
+                *common,
+            ],
         )
         children.append(work)
         ports["work"], _ = _wait_banner(work)

@@ -20,10 +20,12 @@ POSITION_ONLY = 0b0000_1101_1111_1000
 class MavClient:
     """Send messages to vehicles and wait for particular replies."""
 
-    def __init__(self, *vehicles: Address, system_id: int = GCS_SYSTEM_ID) -> None:
+    def __init__(
+        self, *vehicles: Address, system_id: int = GCS_SYSTEM_ID, signing_key: bytes | None = None
+    ) -> None:
         self.vehicles = list(vehicles)
         self.vehicle = self.vehicles[0]
-        self.endpoint = UdpEndpoint(MavlinkCodec(system_id, GCS_COMPONENT_ID))
+        self.endpoint = UdpEndpoint(MavlinkCodec(system_id, GCS_COMPONENT_ID, signing_key))
         self.queue = MessageQueue(self.endpoint)
         self.seen: list[Any] = []
 

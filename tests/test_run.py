@@ -90,12 +90,28 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert metrics == {k: summary[k] for k in metrics}, "the tlog alone gives the same metrics"
     assert summary["scenario_source"] == str(scenario)
 
-    again = _run(scenario, tmp_path / "b", "--seed", "2")
+    # The same seed again, this time with every link signed: identical results.
+    key = tmp_path / "link.key"
+    key.write_bytes(bytes(range(32)))
+    again = _run(scenario, tmp_path / "b", "--seed", "2", "--signing-key", str(key))
     assert again.returncode == 0, again.stderr
     second = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert {k: v for k, v in summary.items() if k not in VOLATILE} == {
         k: v for k, v in second.items() if k not in VOLATILE
     }
+    dump = subprocess.run(
+        [
+            str(Path(sys.executable).parent / "mavlogdump.py"),
+            "--types",
+            "SET_POSITION_TARGET_LOCAL_NED",
+            str(tmp_path / "b" / "gcs.tlog"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert dump.returncode == 0, dump.stderr
+    assert dump.stdout.count("SET_POSITION_TARGET_LOCAL_NED") == 4 * summary["control_cycles"]
 
 
 def test_a_dead_work_vehicle_ends_the_run_with_a_clear_error(scenario, tmp_path):

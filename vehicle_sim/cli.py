@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -11,6 +12,7 @@ from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
 from mission.errors import InputError
 from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.plan_files import read_vehicle_waypoints
+from mission.signing import read_signing_key
 from mission.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
 from mission.world import World
 from vehicle_sim.server import ClockSettings, VehicleServer, install_signal_handlers
@@ -60,6 +62,12 @@ def build_parser() -> OneLineArgumentParser:
         help="work: send truth here (default: each support's default truth port)",
     )
     parser.add_argument(
+        "--signing-key",
+        type=Path,
+        metavar="FILE",
+        help="MAVLink 2 signing: 32-byte secret (raw or 64 hex digits); unsigned commands refused",
+    )
+    parser.add_argument(
         "--exit-with-parent",
         action="store_true",
         help="stop when the process that started this one dies",
@@ -76,6 +84,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     port = args.port if args.port is not None else identity.default_port()
     _check_port(port, "--port", allow_any=True)
     outs = [_address(text, "--out") for text in args.out]
+    key = read_signing_key(args.signing_key) if args.signing_key is not None else None
     world = World.load(args.scenario)
     scenario = world.scenario
     if args.home:
@@ -93,7 +102,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             destinations = [_address(text, "--truth-out") for text in args.truth_out]
         truth_sender = TruthSender(identity.system_id, destinations)
     try:
-        endpoint = UdpEndpoint(MavlinkCodec(identity.system_id, 1), (args.host, port))
+        codec = MavlinkCodec(identity.system_id, 1, key)
+        endpoint = UdpEndpoint(codec, (args.host, port))
         if not identity.is_work:
             truth_port = args.truth_port
             if truth_port is None:

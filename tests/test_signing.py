@@ -1,0 +1,94 @@
+"""MAVLink 2 signing: a signed vehicle obeys only correctly signed commands, setpoints and
+mission uploads, and counts what it refused; key files are checked."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from mission.errors import InputError
+from mission.frames import GeodeticFrame
+from mission.signing import read_signing_key
+from tests.mav_client import MavClient, last, truth_of
+from tests.processes import vehicle_process
+
+KEY = bytes(range(32))
+WRONG = bytes(range(1, 33))
+HOME = np.array([0.0, -10.0, 7.0])
+
+
+@pytest.fixture
+def key_file(tmp_path):
+    path = tmp_path / "link.key"
+    path.write_text(KEY.hex() + "\n")
+    return path
+
+
+def _mission_count(client: MavClient) -> object:
+    """Start a mission upload; the vehicle's first MISSION_REQUEST_INT, if any."""
+    client.send(mavlink2.MAVLink_mission_count_message(2, 1, 2, 0))
+    return client.wait_for("MISSION_REQUEST_INT", 1.5)
+
+
+@pytest.mark.parametrize(
+    ("client_key", "obeyed"),
+    [(KEY, True), (None, False), (WRONG, False)],
+    ids=["signed", "unsigned", "wrong-key"],
+)
+def test_a_signed_vehicle_obeys_only_signed_traffic(key_file, along, client_key, obeyed):
+    frame = GeodeticFrame(along.world.anchor)
+    with vehicle_process("support-1", "--signing-key", str(key_file)) as vehicle:
+        client = MavClient(vehicle.address, signing_key=client_key)
+        clock = MavClient(vehicle.address, signing_key=KEY)  # a signed peer drives the clock
+        upload = _mission_count(client)
+        mode = client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 4, system_id=2)
+        arm = client.command(mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 1, system_id=2)
+        client.setpoint(2, HOME + np.array([3.0, 0.0, 0.0]))
+        client.send(mavlink2.MAVLink_system_time_message(0, 60_000))  # a forged clock jump
+        messages = clock.step_to(500)
+        client.close()
+        clock.close()
+        log = vehicle.stop()
+    assert (mode, arm) == ((mavlink2.MAV_RESULT_ACCEPTED,) * 2 if obeyed else (None, None))
+    moved = np.linalg.norm(truth_of(last(messages, "SIM_STATE"), frame) - HOME)
+    assert moved == pytest.approx(0.5 if obeyed else 0.0, abs=0.02)
+    assert (upload is not None) == obeyed
+    refused = [line for line in log.splitlines() if "signature" in line]
+    if obeyed:
+        assert not refused, log
+    else:  # mode, arm, setpoint, clock jump, mission count: five packets at least
+        count = int(re.search(r"signature (\d+)", log).group(1))
+        assert count >= 5, log
+
+
+def test_signed_telemetry_carries_a_signature(key_file):
+    with vehicle_process("support-1", "--signing-key", str(key_file)) as vehicle:
+        client = MavClient(vehicle.address, signing_key=KEY)
+        messages = client.step_to(500)
+        client.close()
+    assert messages and all(m.get_signed() for m in messages)
+
+
+@pytest.mark.parametrize(
+    ("content", "problem"),
+    [
+        (b"", "found 0 bytes"),
+        (b"\x01" * 31, "found 31 bytes"),
+        (b"z" * 64, "not hexadecimal"),
+        (b"ab" * 40, "found 80 bytes"),
+    ],
+)
+def test_bad_key_files_are_named_with_the_problem(tmp_path, content, problem):
+    path = tmp_path / "bad.key"
+    path.write_bytes(content)
+    with pytest.raises(InputError, match=problem):
+        read_signing_key(path)
+    assert read_signing_key(_write(tmp_path / "raw.key", KEY)) == KEY
+
+
+def _write(path, data: bytes):
+    path.write_bytes(data)
+    return path
