@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from mission.batch_table import write_tables
+from mission.cli_common import child_environment
 
 POLL_S = 0.2
 
@@ -106,6 +108,7 @@ def _run_pool(
     """Keep ``jobs`` runs going; on any exit (Ctrl-C included) stop the ones still running."""
     queue = list(pending)
     running: dict[Trial, subprocess.Popen] = {}
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         while queue or running:
             while queue and len(running) < jobs:
@@ -117,6 +120,7 @@ def _run_pool(
                     finish(trial, process.returncode)
             time.sleep(POLL_S)
     finally:
+        signal.signal(signal.SIGTERM, previous)
         for process in running.values():
             process.terminate()
         for process in running.values():
@@ -125,6 +129,10 @@ def _run_pool(
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
+
+
+def _raise_interrupt(*_: object) -> None:
+    raise KeyboardInterrupt
 
 
 def _start_run(trial: Trial, run_dir: Path) -> subprocess.Popen:
@@ -146,7 +154,13 @@ def _start_run(trial: Trial, run_dir: Path) -> subprocess.Popen:
         "--exit-with-parent",
     ]
     with (run_dir / "mission.log").open("w") as log:
-        return subprocess.Popen(command, stdout=log, stderr=log, stdin=subprocess.DEVNULL)
+        return subprocess.Popen(
+            command,
+            stdout=log,
+            stderr=log,
+            stdin=subprocess.DEVNULL,
+            env=child_environment(),
+        )
 
 
 def _one_line(summary: dict[str, Any]) -> str:

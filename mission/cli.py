@@ -218,7 +218,11 @@ def _batch(args) -> int:
         for method in methods
         for seed in range(args.trials)
     ]
-    result = run_batch(BatchOptions(trials, args.out, args.jobs))
+    try:
+        result = run_batch(BatchOptions(trials, args.out, args.jobs))
+    except KeyboardInterrupt:
+        print(f"batch interrupted; finished runs are kept in {args.out}: run again to resume")
+        return 130
     print((args.out / "table.md").read_text(), end="")
     print(
         f"{result['finished']} runs finished, {result['skipped']} already done, "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable, Sequence
 
@@ -41,6 +42,14 @@ def parse_point(values: Sequence[float], flag: str) -> tuple[float, float, float
     return float(values[0]), float(values[1]), float(values[2])
 
 
+PARENT_PID_VARIABLE = "MISSION_PARENT_PID"
+
+
+def child_environment() -> dict[str, str]:
+    """The environment for a child that calls :func:`die_with_parent`: names this process."""
+    return {**os.environ, PARENT_PID_VARIABLE: str(os.getpid())}
+
+
 def die_with_parent() -> None:
     """Ask Linux to send SIGTERM when the parent process dies (no orphans); no-op elsewhere."""
     import contextlib
@@ -50,3 +59,6 @@ def die_with_parent() -> None:
     if sys.platform.startswith("linux"):
         with contextlib.suppress(OSError, AttributeError):
             ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)
+        parent = os.environ.get(PARENT_PID_VARIABLE)
+        if parent is not None and parent.isdigit() and os.getppid() != int(parent):
+            os.kill(os.getpid(), signal.SIGTERM)  # the parent died before prctl took effect

@@ -18,6 +18,7 @@ from typing import Any
 
 from mission.analysis import analyze_tlog, mpc_stats
 from mission.atomic import write_text_atomically
+from mission.cli_common import child_environment
 from mission.plan_files import vehicle_names
 from mission.settings import Scenario
 
@@ -150,7 +151,11 @@ def _start(out_dir: Path, name: str, arguments: list[str]) -> Child:
     log = out_dir / f"{name}.log"
     handle = log.open("w")
     process = subprocess.Popen(
-        [sys.executable, *arguments], stdout=handle, stderr=handle, stdin=subprocess.DEVNULL
+        [sys.executable, *arguments],
+        stdout=handle,
+        stderr=handle,
+        stdin=subprocess.DEVNULL,
+        env=child_environment(),
     )
     handle.close()
     return Child(name, process, log)

@@ -137,3 +137,43 @@ def test_a_three_seed_paired_along_batch_ac_beats_nac_on_every_seed(tmp_path):
     assert again.returncode == 0, again.stderr
     assert "0 runs finished, 6 already done" in again.stdout
     assert (tmp_path / "results.csv").read_bytes() == before
+
+
+def test_a_terminated_batch_leaves_no_process_behind(tmp_path):
+    import signal
+    import time
+
+    out = tmp_path / "stopped"
+    batch = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "mission",
+            "batch",
+            "along",
+            "--trials",
+            "2",
+            "--methods",
+            "ac",
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not list(out.glob("runs/*/gcs.tlog")):
+            time.sleep(0.1)
+        assert list(out.glob("runs/*/gcs.tlog")), "a run got going"
+        batch.send_signal(signal.SIGTERM)
+        stdout, _ = batch.communicate(timeout=60)
+    finally:
+        if batch.poll() is None:
+            batch.kill()
+    assert batch.returncode == 130 and "run again to resume" in stdout
+    left = subprocess.run(["pgrep", "-f", "--", str(out)], capture_output=True, text=True)
+    assert left.stdout.split() == []
+    assert not list(out.glob("runs/*/summary.json"))  # nothing half-finished counts as done
