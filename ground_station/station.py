@@ -7,6 +7,7 @@ epoch; the per-cycle record and snapshots of G are written alongside as the run 
 from __future__ import annotations
 
 import json
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -51,6 +52,8 @@ class StationConfig:
     tlog_path: Path | None = None  # default: out_dir / "gcs.tlog"
     signing_key: bytes | None = None  # MAVLink 2 signing secret
     step_timeout_wall_s: float = 5.0
+    late_grace_wall_s: float = 0.05  # lockstep: how long a late vehicle is waited for
+    link_loss_s: float = 3.0  # simulated seconds of silence before a vehicle counts as lost
     connect_timeout_wall_s: float = 30.0
 
 
@@ -64,6 +67,9 @@ class VehicleView:
     latest: dict[str, Any] = field(default_factory=dict)
     step_ms: int = -1
     heartbeat_wall: float = -1.0
+    heard_s: float = 0.0  # simulated time of the last message from it
+    lost: bool = False  # silent for link_loss_s: out of fusion and the MPCs
+    late: bool = False  # missed the last lockstep marker: not waited for
 
 
 class GroundStation:
@@ -109,6 +115,7 @@ class GroundStation:
             return
         kind = message.get_type()
         view.latest[kind] = message
+        view.heard_s = self.sim_time_s
         if kind == "HEARTBEAT":
             view.heartbeat_wall = time.monotonic()
         elif kind == "SYSTEM_TIME":
@@ -189,6 +196,7 @@ class GroundStation:
         scn = self.scenario
         while self.sim_time_s < scn.run.timeout_s - 1e-9:
             self._advance_clock()
+            self._check_links(state)
             measurements = [
                 support_measurement(
                     name,
@@ -198,6 +206,7 @@ class GroundStation:
                     self.frame,
                 )
                 for name in supports
+                if not self.views[name].lost
             ]
             output = control_cycle(state, measurements, models)
             self._command(state, output)
@@ -231,13 +240,51 @@ class GroundStation:
             tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
             for view in self.views.values():
                 self.send(tick, view)
+            awaited = [v for v in self.views.values() if not v.lost and not v.late]
             self.pump(
                 self.config.step_timeout_wall_s,
-                lambda: all(v.step_ms >= target_ms for v in self.views.values()),
+                lambda: all(v.step_ms >= target_ms for v in awaited),
             )
+            stragglers = [v for v in self.views.values() if v.step_ms < target_ms and not v.lost]
+            if stragglers:
+                self.pump(
+                    self.config.late_grace_wall_s,
+                    lambda: all(v.step_ms >= target_ms for v in stragglers),
+                )
+            for view in self.views.values():
+                view.late = view.step_ms < target_ms
         else:
             self.pump(step / self.config.speedup)
             self.sim_time_s += step
+
+    def _check_links(self, state: StationState) -> None:
+        """Drop a support that fell silent from fusion and the MPCs; take it back when heard."""
+        for view in self.views.values():
+            silent = self.sim_time_s - view.heard_s
+            if not view.lost and silent >= self.config.link_loss_s - 1e-9:
+                if view.name == "work":
+                    raise StationError(f"work lost: no message for {silent:.1f} s")
+                view.lost = True
+                self._announce(f"{view.name} lost: silent {silent:.1f} s", to_log=True)
+            elif view.lost and silent < self.scenario.control.t_cont_s - 1e-9:
+                view.lost = False
+                state.warm.pop(view.name, None)
+                state.last_support_command.pop(view.name, None)
+                self._rejoin(view)
+                self._announce(f"{view.name} back", to_log=True)
+
+    def _rejoin(self, view: VehicleView) -> None:
+        """GUIDED and arm a vehicle that came back (its ACKs arrive with later steps)."""
+        for command, params in (
+            (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
+            (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1, 0)),
+        ):
+            self.send(
+                mavlink2.MAVLink_command_long_message(
+                    view.system_id, 1, command, 0, *params, 0, 0, 0, 0, 0
+                ),
+                view,
+            )
 
     def _current(self, name: str, kind: str) -> Any | None:
         """The vehicle's message of this kind from the current step (None if late or missing)."""
@@ -294,7 +341,10 @@ class GroundStation:
             view,
         )
 
-    def _announce(self, text: str) -> None:
+    def _announce(self, text: str, to_log: bool = False) -> None:
+        """A STATUSTEXT in the tlog (and on stderr for link events)."""
+        if to_log:
+            print(f"ground station: t={self.sim_time_s:.1f} s: {text}", file=sys.stderr, flush=True)
         message = mavlink2.MAVLink_statustext_message(
             mavlink2.MAV_SEVERITY_INFO, text.encode()[:50], 0, 0
         )

@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import os
+import re
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +26,7 @@ from mission.settings import Scenario
 from mission.world import World
 
 GCS_SYSTEM_ID = 255
+_LINK_EVENT = re.compile(r"^support-\d+ (lost|back)")
 
 
 @dataclass
@@ -35,6 +37,7 @@ class RunTrace:
     estimates: dict[float, np.ndarray] = field(default_factory=dict)
     ticks: set[float] = field(default_factory=set)
     completion: float | None = None
+    link_events: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def supports(self) -> list[int]:
@@ -75,6 +78,8 @@ def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
         elif kind == "STATUSTEXT" and "Mission complete" in message.text:
             trace.completion = t if trace.completion is None else trace.completion
+        elif kind == "STATUSTEXT" and _LINK_EVENT.match(message.text):
+            trace.link_events.append({"t": t, "event": message.text})
     return trace
 
 
@@ -112,6 +117,7 @@ def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
         "multipath_steps": counts,
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": _stats([float(e) for e in errors]),
+        "link_events": trace.link_events,
     }
 
 

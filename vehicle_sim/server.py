@@ -4,7 +4,8 @@ Stepping lives in :class:`~vehicle_sim.vehicle.Vehicle`; this module only decide
 (BlueSky's split between simulation and pacing):
 
 - lockstep: the ground station is the master clock. A SYSTEM_TIME from it (time_boot_ms = T)
-  means "advance to T". With no tick for ``lockstep_timeout_wall_s`` the vehicle advances one
+  means "advance to T"; a vehicle started into a running mission takes up the clock from its
+  first tick. With no tick for ``lockstep_timeout_wall_s`` the vehicle advances one
   step alone, so a lost packet cannot freeze it; before the first tick it only sends heartbeats.
 - real time: one step every ``t_cont / speedup`` wall seconds.
 
@@ -165,6 +166,8 @@ class VehicleServer:
         """The ground station's clock: advance to ``time_s`` (bounded jumps only)."""
         vehicle = self.vehicle
         assert vehicle is not None
+        if not self._started and vehicle.steps == 0 and time_s > vehicle.step_s + 1e-9:
+            vehicle.join_clock(time_s)  # a vehicle (re)started into a running mission
         if not 0 < time_s - vehicle.sim_time_s <= MAX_TICK_JUMP_S:
             if time_s > vehicle.sim_time_s:
                 vehicle.counters.reject("clock tick too far ahead")

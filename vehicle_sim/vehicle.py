@@ -229,6 +229,12 @@ class Vehicle:
         self.steps += 1
         self.sim_time_s = self.steps * self.step_s
 
+    def join_clock(self, time_s: float) -> None:
+        """Take up a running clock before the first step: the next step ends at ``time_s``."""
+        self.steps = max(0, round(time_s / self.step_s) - 1)
+        self.sim_time_s = self.steps * self.step_s
+        self._last_setpoint_s = self.sim_time_s
+
     def _check_failsafe(self) -> None:
         if not (self.armed and self.mode == modes.GUIDED) or self.failsafe:
             return

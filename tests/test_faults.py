@@ -1,0 +1,131 @@
+"""Faults during a run: a support vehicle killed and restarted, the ground station killed."""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mission.analysis import read_tlog
+from mission.scenario import load_scenario
+from tests.processes import ROOT, stop_process
+
+FAULT_SCENARIO = "extends: along\nname: fault-run\n"
+BANNER = re.compile(r"listening on [\d.]+:(\d+), truth port (\d+)")
+
+
+@pytest.fixture
+def scenario(tmp_path) -> Path:
+    path = tmp_path / "fault-run.yaml"
+    path.write_text(FAULT_SCENARIO)
+    return path
+
+
+def _start_run(scenario: Path, out: Path) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+
+
+def _cycles(out: Path) -> int:
+    try:
+        return sum(1 for _ in (out / "records.jsonl").open())
+    except OSError:
+        return 0
+
+
+def _wait_cycles(out: Path, cycles: int, timeout_s: float = 120.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while _cycles(out) < cycles:
+        assert time.monotonic() < deadline, f"the run did not reach cycle {cycles}"
+        time.sleep(0.05)
+
+
+def _pids(pattern: str) -> list[str]:
+    return subprocess.run(
+        ["pgrep", "-f", "--", pattern], capture_output=True, text=True
+    ).stdout.split()
+
+
+def test_a_killed_support_is_dropped_then_taken_back(scenario, tmp_path):
+    out = tmp_path / "run"
+    run = _start_run(scenario, out)
+    restarted = None
+    try:
+        _wait_cycles(out, 60)
+        port, truth_port = BANNER.search((out / "support-2.log").read_text()).groups()
+        victim = _pids(f"--vehicle support-2 .*{scenario}")
+        assert len(victim) == 1
+        subprocess.run(["kill", "-9", *victim], check=True)
+        killed_at = _cycles(out)
+        _wait_cycles(out, killed_at + 20)  # lost after 3 s = 6 cycles; let it run without
+        restarted = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "vehicle_sim",
+                "--vehicle",
+                "support-2",
+                "--scenario",
+                str(scenario),
+                "--port",
+                port,
+                "--truth-port",
+                truth_port,
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+        _, stderr = run.communicate(timeout=300)
+    finally:
+        if run.poll() is None:
+            run.kill()
+        if restarted is not None:
+            stop_process(restarted)
+    assert run.returncode == 0, stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is True
+    events = [(e["t"], e["event"].split(":")[0]) for e in summary["link_events"]]
+    assert [e for _, e in events] == ["support-2 lost", "support-2 back"], events
+    trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
+    times, _ = trace.track(3)
+    last_heard = max(t for t in times if t < events[0][0])
+    assert events[0][0] - last_heard <= 3.0 + 0.5  # noticed within 3 s of simulated time
+    records = [json.loads(line) for line in (out / "records.jsonl").open()]
+    away = [r for r in records if events[0][0] <= r["t"] < events[1][0]]
+    assert away and all("support-2" not in r["mpc"] for r in away)
+    assert all(set(r["mpc"]) == {"support-1", "support-3"} for r in away)
+    after = [r for r in records if r["t"] > events[1][0] + 5]
+    assert any("support-2" in r["contributing"] for r in after), "fused again once back"
+    assert _pids(str(scenario)) == []
+
+
+def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(scenario, tmp_path):
+    out = tmp_path / "run"
+    run = _start_run(scenario, out)
+    try:
+        _wait_cycles(out, 40)
+        gcs = _pids(f"-m ground_station .*{scenario}")
+        assert len(gcs) == 1
+        subprocess.run(["kill", "-9", *gcs], check=True)
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            run.send_signal(signal.SIGKILL)
+    assert run.returncode == 1
+    assert "ground_station exited with status -9" in stderr and "logs kept" in stderr
+    trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
+    assert len(trace.ticks) >= 40  # every flushed cycle is there and parses
+    assert _pids(str(scenario)) == []
