@@ -10,6 +10,7 @@ from pathlib import Path
 
 from mission.cli_common import OneLineArgumentParser, die_with_parent, run_guarded
 from mission.errors import InputError
+from mission.link_impairment import LinkSettings
 from mission.mavlink_udp import parse_address
 from mission.plan_files import vehicle_names
 from mission.signing import read_signing_key
@@ -64,12 +65,35 @@ def build_parser() -> OneLineArgumentParser:
         "--speedup", type=float, help="real time, this many times faster (default: lockstep)"
     )
     parser.add_argument(
+        "--link-loss",
+        type=float,
+        default=0.0,
+        metavar="P",
+        help="drop each datagram sent with probability P (seeded; testing)",
+    )
+    parser.add_argument(
+        "--link-delay-ms",
+        type=float,
+        default=0.0,
+        metavar="D",
+        help="delay each datagram sent by D milliseconds (testing)",
+    )
+    parser.add_argument(
         "--signing-key",
         type=Path,
         metavar="FILE",
         help="MAVLink 2 signing: 32-byte secret (raw or 64 hex digits)",
     )
     return parser
+
+
+def link_settings(args) -> LinkSettings:
+    """--link-loss and --link-delay-ms, checked."""
+    try:
+        return LinkSettings(args.link_loss, args.link_delay_ms)
+    except ValueError as error:
+        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
+        raise InputError("command line", flag, str(error).split(" must ", 1)[-1]) from None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -97,6 +121,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         speedup=args.speedup,
         tlog_path=args.tlog,
         signing_key=read_signing_key(args.signing_key) if args.signing_key else None,
+        link=link_settings(args),
     )
     station = GroundStation(world, config)
     try:

@@ -23,7 +23,9 @@ from ground_station.measurements import support_measurement
 from ground_station.mission_client import MissionClient, MissionTransferError
 from ground_station.support_mpc import SupportMpc
 from ground_station.tlog import TlogWriter
+from mission.atomic import write_text_atomically
 from mission.frames import GeodeticFrame, enu_to_ned
+from mission.link_impairment import LinkSettings
 from mission.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.vehicle_identity import VehicleIdentity
 from mission.waypoints import read_waypoints, row_position_enu
@@ -33,6 +35,7 @@ GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190
 POSITION_ONLY = 0b0000_1101_1111_1000
 SNAPSHOT_EVERY = 20
+COMMAND_TIMEOUT_WALL_S = 5.0  # a command is repeated until acknowledged, this long at most
 
 
 class StationError(RuntimeError):
@@ -51,6 +54,7 @@ class StationConfig:
     speedup: float | None = None  # None: lockstep
     tlog_path: Path | None = None  # default: out_dir / "gcs.tlog"
     signing_key: bytes | None = None  # MAVLink 2 signing secret
+    link: LinkSettings = field(default_factory=LinkSettings)  # loss and delay of what we send
     step_timeout_wall_s: float = 5.0
     late_grace_wall_s: float = 0.05  # lockstep: how long a late vehicle is waited for
     link_loss_s: float = 3.0  # simulated seconds of silence before a vehicle counts as lost
@@ -81,8 +85,14 @@ class GroundStation:
         self.config = config
         self.frame = GeodeticFrame(self.scenario.world.anchor)
         self.endpoint = UdpEndpoint(
-            MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID, config.signing_key)
+            MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID, config.signing_key),
+            link=config.link,
+            link_seed=config.seed * 1000 + GCS_SYSTEM_ID,
         )
+        self.link_stats = {"lost_in": 0, "tick_resends": 0, "late_steps": 0}
+        self._last_seq: dict[int, int] = {}
+        # how long a lockstep tick waits for its marker before being sent again
+        self.retry_wall_s = 0.02 + 2 * config.link.delay_ms / 1000.0
         self.queue = MessageQueue(self.endpoint)
         config.out_dir.mkdir(parents=True, exist_ok=True)
         self.tlog = TlogWriter(config.tlog_path or config.out_dir / "gcs.tlog")
@@ -113,6 +123,7 @@ class GroundStation:
         view = self.by_system.get(message.get_srcSystem())
         if view is None:
             return
+        self._count_gap(view.system_id, message.get_seq())
         kind = message.get_type()
         view.latest[kind] = message
         view.heard_s = self.sim_time_s
@@ -120,6 +131,17 @@ class GroundStation:
             view.heartbeat_wall = time.monotonic()
         elif kind == "SYSTEM_TIME":
             view.step_ms = int(message.time_boot_ms)
+
+    def _count_gap(self, system_id: int, seq: int) -> None:
+        """Packets lost on the way in, from gaps in the sender's sequence numbers."""
+        last = self._last_seq.get(system_id)
+        if last is not None:
+            gap = (seq - last - 1) % 256
+            if gap < 128:  # larger: a repeat or reordering, not a loss
+                self.link_stats["lost_in"] += gap
+            else:
+                return
+        self._last_seq[system_id] = seq
 
     def pump(self, seconds: float, until: Callable[[], bool] | None = None) -> None:
         """Receive and log for up to ``seconds`` or until ``until()`` holds."""
@@ -171,13 +193,15 @@ class GroundStation:
                 (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
                 (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1, 0)),
             ):
-                self.send(
-                    mavlink2.MAVLink_command_long_message(
-                        view.system_id, 1, command, 0, *params, 0, 0, 0, 0, 0
-                    ),
-                    view,
-                )
-                self.pump(3.0, lambda v=view, c=command: _acked(v, c))
+                deadline = time.monotonic() + COMMAND_TIMEOUT_WALL_S
+                while not _acked(view, command) and time.monotonic() < deadline:
+                    self.send(
+                        mavlink2.MAVLink_command_long_message(
+                            view.system_id, 1, command, 0, *params, 0, 0, 0, 0, 0
+                        ),
+                        view,
+                    )
+                    self.pump(4 * self.retry_wall_s, lambda v=view, c=command: _acked(v, c))
                 if not _acked(view, command):
                     raise StationError(f"{view.name} did not accept command {command}")
                 view.latest.pop("COMMAND_ACK", None)
@@ -192,6 +216,8 @@ class GroundStation:
         models, state = self._initial(waypoints)
         supports = [n for n in self.views if n != "work"]
         self._snapshot(models.g, "initial")
+        self._last_seq.clear()  # count losses from here: set-up traffic is not all logged here
+        self.link_stats["lost_in"] = 0
         completion = None
         scn = self.scenario
         while self.sim_time_s < scn.run.timeout_s - 1e-9:
@@ -221,6 +247,7 @@ class GroundStation:
                 break
         self._snapshot(models.g, "final")
         self.tlog.flush()
+        self._write_link_stats()
         return {
             "completed": completion is not None,
             "completion_time_s": completion,
@@ -228,6 +255,18 @@ class GroundStation:
             "sim_time_s": self.sim_time_s,
             "wall_time_s": time.monotonic() - start_wall,
         }
+
+    def _write_link_stats(self) -> None:
+        """link.json: what the links lost and how the lockstep recovered."""
+        link = self.endpoint.link
+        stats = {
+            "loss": self.config.link.loss,
+            "delay_ms": self.config.link.delay_ms,
+            "dropped_out": link.dropped if link is not None else 0,
+            **self.link_stats,
+            "rejected": dict(self.endpoint.counters.rejected),
+        }
+        write_text_atomically(self.config.out_dir / "link.json", json.dumps(stats) + "\n")
 
     def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
         return build_models(self.world, waypoints, self.config.adaptive, self.config.seed)
@@ -241,10 +280,18 @@ class GroundStation:
             for view in self.views.values():
                 self.send(tick, view)
             awaited = [v for v in self.views.values() if not v.lost and not v.late]
-            self.pump(
-                self.config.step_timeout_wall_s,
-                lambda: all(v.step_ms >= target_ms for v in awaited),
-            )
+            deadline = time.monotonic() + self.config.step_timeout_wall_s
+            while True:
+                self.pump(
+                    min(self.retry_wall_s, max(0.0, deadline - time.monotonic())),
+                    lambda: all(v.step_ms >= target_ms for v in awaited),
+                )
+                behind = [v for v in awaited if v.step_ms < target_ms]
+                if not behind or time.monotonic() >= deadline:
+                    break
+                for view in behind:  # the tick or the step's telemetry was lost: ask again
+                    self.send(tick, view)
+                    self.link_stats["tick_resends"] += 1
             stragglers = [v for v in self.views.values() if v.step_ms < target_ms and not v.lost]
             if stragglers:
                 self.pump(
@@ -253,6 +300,7 @@ class GroundStation:
                 )
             for view in self.views.values():
                 view.late = view.step_ms < target_ms
+                self.link_stats["late_steps"] += int(view.late and not view.lost)
         else:
             self.pump(step / self.config.speedup)
             self.sim_time_s += step

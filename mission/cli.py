@@ -89,6 +89,12 @@ def build_parser() -> OneLineArgumentParser:
         metavar="HOST:PORT",
         help="every vehicle also streams here (QGroundControl, MAVProxy); use with --realtime",
     )
+    run.add_argument(
+        "--link-loss", type=float, default=0.0, metavar="P", help="drop datagrams (every link)"
+    )
+    run.add_argument(
+        "--link-delay-ms", type=float, default=0.0, metavar="D", help="delay datagrams (ms)"
+    )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
     batch = commands.add_parser(
@@ -168,6 +174,13 @@ def _run(args) -> int:
             parse_address(args.observer, "--observer")
         except ValueError as error:
             raise InputError("command line", "--observer", str(error)) from None
+    from mission.link_impairment import LinkSettings
+
+    try:
+        link = LinkSettings(args.link_loss, args.link_delay_ms)
+    except ValueError as error:
+        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
+        raise InputError("command line", flag, str(error).split(" must ", 1)[-1]) from None
     options = RunOptions(
         args.scenario,
         args.method,
@@ -176,6 +189,7 @@ def _run(args) -> int:
         args.speedup if args.realtime else None,
         args.signing_key.resolve() if args.signing_key else None,
         args.observer,
+        link,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     try:

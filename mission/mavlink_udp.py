@@ -12,6 +12,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.link_impairment import ImpairedLink, LinkSettings
 from mission.signing import enable_signing, signing_rejections
 
 Address = tuple[str, int]
@@ -101,13 +102,33 @@ class MavlinkCodec:
 class UdpEndpoint:
     """A non-blocking UDP socket carrying MAVLink for one identity."""
 
-    def __init__(self, codec: MavlinkCodec, bind: Address = ("127.0.0.1", 0)) -> None:
+    def __init__(
+        self,
+        codec: MavlinkCodec,
+        bind: Address = ("127.0.0.1", 0),
+        link: LinkSettings | None = None,
+        link_seed: int = 0,
+    ) -> None:
         self.codec = codec
         self.counters = LinkCounters()
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
         self.sock.bind(bind)
         self.sock.setblocking(False)
+        self.link = (
+            ImpairedLink(self.sock, link, link_seed) if link is not None and link.impaired else None
+        )
+
+    def _transmit(self, datagram: bytes, destination: Address) -> bool:
+        """One datagram out, through the impaired link if there is one."""
+        if self.link is not None:
+            return self.link.send(datagram, destination)
+        try:
+            self.sock.sendto(datagram, destination)
+            return True
+        except OSError:
+            self.counters.send_errors += 1
+            return False
 
     @property
     def address(self) -> Address:
@@ -148,14 +169,11 @@ class UdpEndpoint:
         """Encode once and send to every destination; return the packet bytes."""
         packet = self.codec.encode(message)
         for destination in destinations:
-            try:
-                self.sock.sendto(packet, destination)
+            if self._transmit(packet, destination):
                 self.counters.packets_out += 1
-            except OSError:
-                self.counters.send_errors += 1
         return packet
 
-    def send_many(self, messages: list[Any], destinations: list[Address]) -> None:
+    def send_many(self, messages: list[Any], destinations: list[Address]) -> list[bytes]:
         """Encode several messages and send them packed into as few datagrams as fit.
 
         MAVLink over UDP is a byte stream cut into datagrams: receivers (pymavlink, MAVProxy,
@@ -171,16 +189,27 @@ class UdpEndpoint:
             current += packet
         if current:
             datagrams.append(bytes(current))
+        self.resend(datagrams, destinations)
+        self.counters.packets_out += len(messages) * len(destinations)
+        return datagrams
+
+    def resend(self, datagrams: list[bytes], destinations: list[Address]) -> None:
+        """Send already-encoded datagrams (e.g. a step's telemetry asked for again)."""
         for destination in destinations:
             for datagram in datagrams:
-                try:
-                    self.sock.sendto(datagram, destination)
-                except OSError:
-                    self.counters.send_errors += 1
-            self.counters.packets_out += len(messages)
+                self._transmit(datagram, destination)
+
+    def summary(self) -> str:
+        """The counters, and what the impaired link dropped and delayed, in one line."""
+        text = self.counters.summary()
+        if self.link is not None:
+            text += f", link dropped {self.link.dropped}, delayed {self.link.delayed}"
+        return text
 
     def close(self) -> None:
         """Close the socket."""
+        if self.link is not None:
+            self.link.close()
         self.sock.close()
 
 

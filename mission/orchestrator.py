@@ -12,13 +12,14 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from mission.analysis import analyze_tlog, mpc_stats
 from mission.atomic import write_text_atomically
 from mission.cli_common import child_environment
+from mission.link_impairment import LinkSettings
 from mission.plan_files import vehicle_names
 from mission.settings import Scenario
 
@@ -41,6 +42,7 @@ class RunOptions:
     speedup: float | None = None
     signing_key: Path | None = None  # the key file, passed to every process
     observer: str | None = None  # HOST:PORT every vehicle also streams to
+    link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
 
 
 @dataclass
@@ -63,6 +65,9 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         if options.signing_key is not None:
             pacing += ["--signing-key", str(options.signing_key)]
         observer = ["--out", options.observer] if options.observer else []
+        if options.link.impaired:
+            pacing += ["--link-loss", str(options.link.loss)]
+            pacing += ["--link-delay-ms", str(options.link.delay_ms)]
         common = [
             "--scenario",
             options.scenario,
@@ -139,6 +144,9 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     summary["wall_time_s"] = round(wall, 3)
     summary["realtime_factor"] = round(simulated / wall, 3) if wall > 0 else None
     summary["mpc_solve_ms"] = mpc_stats(options.out_dir / "records.jsonl")
+    link_file = options.out_dir / "link.json"
+    if link_file.is_file():
+        summary["link"] = json.loads(link_file.read_text())
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
 

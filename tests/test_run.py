@@ -141,3 +141,18 @@ def test_a_dead_work_vehicle_ends_the_run_with_a_clear_error(scenario, tmp_path)
     assert "work died" in stderr and "logs kept" in stderr
     assert (out / "gcs.tlog").exists() and (out / "work.log").exists()
     assert _children_of(scenario) == []
+
+
+def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_path):
+    out = tmp_path / "lossy"
+    result = _run(scenario, out, "--link-loss", "0.2", "--link-delay-ms", "50")
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is True
+    link = summary["link"]
+    assert (link["loss"], link["delay_ms"]) == (0.2, 50.0)
+    # every process drops about a fifth of what it sends; lost ticks and steps are asked again
+    sent = 8 * summary["control_cycles"]  # at least: tick, estimate, setpoint per vehicle...
+    assert 0.1 * sent < link["dropped_out"] < 0.4 * sent
+    assert link["tick_resends"] > 0
+    assert _children_of(scenario) == []

@@ -10,6 +10,7 @@ import numpy as np
 
 from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
 from mission.errors import InputError
+from mission.link_impairment import LinkSettings
 from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.plan_files import read_vehicle_waypoints
 from mission.signing import read_signing_key
@@ -62,6 +63,20 @@ def build_parser() -> OneLineArgumentParser:
         help="work: send truth here (default: each support's default truth port)",
     )
     parser.add_argument(
+        "--link-loss",
+        type=float,
+        default=0.0,
+        metavar="P",
+        help="drop each datagram sent with probability P (seeded; testing)",
+    )
+    parser.add_argument(
+        "--link-delay-ms",
+        type=float,
+        default=0.0,
+        metavar="D",
+        help="delay each datagram sent by D milliseconds (testing)",
+    )
+    parser.add_argument(
         "--signing-key",
         type=Path,
         metavar="FILE",
@@ -75,6 +90,15 @@ def build_parser() -> OneLineArgumentParser:
     return parser
 
 
+def link_settings(args) -> LinkSettings:
+    """--link-loss and --link-delay-ms, checked."""
+    try:
+        return LinkSettings(args.link_loss, args.link_delay_ms)
+    except ValueError as error:
+        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
+        raise InputError("command line", flag, str(error).split(" must ", 1)[-1]) from None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Start the vehicle and serve until terminated."""
     args = build_parser().parse_args(argv)
@@ -85,6 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     _check_port(port, "--port", allow_any=True)
     outs = [_address(text, "--out") for text in args.out]
     key = read_signing_key(args.signing_key) if args.signing_key is not None else None
+    link = link_settings(args)
     world = World.load(args.scenario)
     scenario = world.scenario
     if args.home:
@@ -103,7 +128,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         truth_sender = TruthSender(identity.system_id, destinations)
     try:
         codec = MavlinkCodec(identity.system_id, 1, key)
-        endpoint = UdpEndpoint(codec, (args.host, port))
+        endpoint = UdpEndpoint(
+            codec, (args.host, port), link, link_seed=args.seed * 1000 + identity.system_id
+        )
         if not identity.is_work:
             truth_port = args.truth_port
             if truth_port is None:

@@ -46,6 +46,7 @@ class MissionServer:
         self.items: list[MissionItem] = []
         self.current = 0
         self._upload: _Upload | None = None
+        self._finished: tuple[tuple[int, int], int] | None = None  # (partner, count) last done
         self.on_changed: Callable[[], None] | None = None
 
     # -- dispatch ---------------------------------------------------------------------------
@@ -90,6 +91,7 @@ class MissionServer:
             self._replace([])
             self._ack(partner, mavlink2.MAV_MISSION_ACCEPTED)
             return
+        self._finished = None
         self._upload = _Upload(partner, int(msg.count), [], now + self.timeout_s, self.retries)
         self._request(self._upload, now)
 
@@ -98,6 +100,9 @@ class MissionServer:
         upload = self._upload
         if _mission_type(msg) != MISSION:
             self._ack(partner, mavlink2.MAV_MISSION_UNSUPPORTED, _mission_type(msg))
+            return
+        if upload is None and self._finished == (partner, msg.seq + 1):
+            self._ack(partner, mavlink2.MAV_MISSION_ACCEPTED)  # our final ACK was lost
             return
         if upload is None or upload.partner != partner:
             self._ack(partner, mavlink2.MAV_MISSION_INVALID_SEQUENCE)
@@ -127,6 +132,7 @@ class MissionServer:
             self._request(upload, now)
             return
         self._upload = None
+        self._finished = (partner, upload.count)
         self._replace(upload.items)
         self._ack(partner, mavlink2.MAV_MISSION_ACCEPTED)
         self._notify(mavlink2.MAV_SEVERITY_INFO, f"Mission accepted: {len(self.items)} items")

@@ -47,6 +47,7 @@ class ServerStats:
 
     auto_steps: int = 0
     truth_waits_timed_out: int = 0
+    resent_steps: int = 0
 
 
 class VehicleServer:
@@ -79,6 +80,7 @@ class VehicleServer:
         self._pending_deadline: float | None = None
         self._parent = os.getppid()
         self._batch: list[Any] | None = None
+        self._last_step: list[bytes] = []  # the last step's datagrams, for a repeated tick
 
     def attach(self, vehicle: Vehicle) -> None:
         """Connect the vehicle whose messages this server carries."""
@@ -102,7 +104,7 @@ class VehicleServer:
             self.vehicle.publish(truth)
         finally:
             batch, self._batch = self._batch, None
-            self.endpoint.send_many(batch, [*self.peers, *self.outs])
+            self._last_step = self.endpoint.send_many(batch, [*self.peers, *self.outs])
 
     # -- main loop --------------------------------------------------------------------------
     def run(self) -> None:
@@ -155,17 +157,23 @@ class VehicleServer:
         self.peers[sender] = now
         if message.get_type() == "SYSTEM_TIME":
             if self.clock.lockstep:
-                self._on_tick(message.time_boot_ms / 1000.0, now)
+                self._on_tick(message.time_boot_ms / 1000.0, now, sender)
             return
         try:
             vehicle.handle(message, now)
         except Exception as error:  # a malformed message never kills the vehicle
             vehicle.counters.reject(f"handler error {type(error).__name__}")
 
-    def _on_tick(self, time_s: float, now: float) -> None:
-        """The ground station's clock: advance to ``time_s`` (bounded jumps only)."""
+    def _on_tick(self, time_s: float, now: float, sender: Address) -> None:
+        """The ground station's clock: advance to ``time_s`` (bounded jumps only). A tick for
+        the step just published asks for its telemetry again (its datagrams were lost)."""
         vehicle = self.vehicle
         assert vehicle is not None
+        if self._last_step and abs(time_s - vehicle.sim_time_s) < 1e-9:
+            if self._pending_deadline is None:
+                self.endpoint.resend(self._last_step, [sender])
+                self.stats.resent_steps += 1
+            return
         if not self._started and vehicle.steps == 0 and time_s > vehicle.step_s + 1e-9:
             vehicle.join_clock(time_s)  # a vehicle (re)started into a running mission
         if not 0 < time_s - vehicle.sim_time_s <= MAX_TICK_JUMP_S:
@@ -258,10 +266,11 @@ class VehicleServer:
         stale = self.truth_receiver.stale_uses if self.truth_receiver else 0
         return (
             f"{vehicle.identity.name}: {vehicle.steps} steps to t={vehicle.sim_time_s:.1f} s; "
-            f"link {self.endpoint.counters.summary()}; vehicle rejected: "
+            f"link {self.endpoint.summary()}; vehicle rejected: "
             f"{dict(sorted(vehicle.counters.rejected.items())) or 'none'}; "
             f"auto steps {self.stats.auto_steps}, truth waits timed out "
-            f"{self.stats.truth_waits_timed_out}, stale truth {stale}"
+            f"{self.stats.truth_waits_timed_out}, stale truth {stale}, "
+            f"steps resent {self.stats.resent_steps}"
         )
 
 
