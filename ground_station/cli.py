@@ -124,6 +124,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         link=link_settings(args),
     )
     station = GroundStation(world, config)
+    host, port = station.endpoint.address
+    print(f"ground station listening on {host}:{port}", file=sys.stderr, flush=True)
     try:
         summary = station.run()
     except StationError as error:

@@ -107,7 +107,8 @@ class MissionClient:
         while (got := self.queue.next(deadline - time.monotonic())) is not None:
             message, sender = got
             if (
-                message.get_srcSystem() == self.system_id
+                sender == self.vehicle
+                and message.get_srcSystem() == self.system_id
                 and message.get_type() in wanted
                 and getattr(message, "target_system", own) == own
                 and (seq is None or getattr(message, "seq", seq) == seq)

@@ -7,6 +7,7 @@ epoch; the per-cycle record and snapshots of G are written alongside as the run 
 from __future__ import annotations
 
 import json
+import socket
 import sys
 import time
 from collections.abc import Callable
@@ -100,7 +101,7 @@ class GroundStation:
         self.snapshots = config.out_dir / "g"
         self.snapshots.mkdir(exist_ok=True)
         self.views = {
-            name: VehicleView(name, VehicleIdentity.parse(name).system_id, address)
+            name: VehicleView(name, VehicleIdentity.parse(name).system_id, _resolved(address))
             for name, address in config.vehicles.items()
         }
         self.by_system = {v.system_id: v for v in self.views.values()}
@@ -119,10 +120,11 @@ class GroundStation:
         self.tlog.write(self.time_usec, packet)
 
     def _log_received(self, message: Any, sender: Address) -> None:
-        self.tlog.write(self.time_usec, message.get_msgbuf())
         view = self.by_system.get(message.get_srcSystem())
-        if view is None:
+        if view is None or sender != view.address:  # only our vehicles, from where they are
+            self.endpoint.counters.reject("unknown sender")
             return
+        self.tlog.write(self.time_usec, message.get_msgbuf())
         self._count_gap(view.system_id, message.get_seq())
         kind = message.get_type()
         view.latest[kind] = message
@@ -463,3 +465,12 @@ def build_models(
         k=min(1, len(waypoints["work"]) - 1),
     )
     return models, state
+
+
+def _resolved(address: Address) -> Address:
+    """(IP, port): replies come from an IP address, so names are looked up once here."""
+    host, port = address
+    try:
+        return socket.gethostbyname(host), port
+    except OSError:
+        raise StationError(f"cannot resolve vehicle host {host!r}") from None

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -129,3 +130,42 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
     trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
     assert len(trace.ticks) >= 40  # every flushed cycle is there and parses
     assert _pids(str(scenario)) == []
+
+
+def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp_path):
+    from tests.test_vehicle_fuzz import _datagrams
+
+    datagrams = _datagrams(seed=2)
+    assert len(datagrams) >= 10_000
+    out = tmp_path / "run"
+    run = _start_run(scenario, out)
+    try:
+        deadline = time.monotonic() + 60
+        found = None
+        while found is None and time.monotonic() < deadline:
+            log = out / "ground_station.log"
+            found = (
+                re.search(r"ground station listening on ([\d.]+):(\d+)", log.read_text())
+                if log.exists()
+                else None
+            )
+            time.sleep(0.02)
+        assert found, "the ground station started"
+        address = (found.group(1), int(found.group(2)))
+        fuzzer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        for i, datagram in enumerate(datagrams):  # while it connects, uploads and flies
+            fuzzer.sendto(datagram, address)
+            if i % 200 == 199:
+                time.sleep(0.002)
+        fuzzer.close()
+        _, stderr = run.communicate(timeout=300)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    assert run.returncode == 0, stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is True
+    assert summary["link"]["rejected"]["unknown sender"] >= 3000
+    assert "Traceback" not in (out / "ground_station.log").read_text()
+    trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
+    assert {s for s, _ in trace.truth} == {1, 2, 3, 4}  # nothing forged reached the log
