@@ -87,6 +87,15 @@ def build_parser() -> OneLineArgumentParser:
     return parser
 
 
+def read_waypoints_file(path: Path) -> None:
+    """Check one vehicle's waypoint file (InputError naming the file and line)."""
+    from mission.waypoints import read_waypoints
+
+    if not path.is_file():
+        raise InputError(str(path), "", "no such waypoint file")
+    read_waypoints(path)
+
+
 def link_settings(args) -> LinkSettings:
     """--link-loss and --link-delay-ms, checked."""
     try:
@@ -111,6 +120,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     waypoints = args.waypoints or Path(scenario.task.waypoints_dir)
     if not waypoints.is_dir():
         raise InputError("command line", "--waypoints", f"{waypoints} is not a directory")
+    for name in vehicles:  # every waypoint file is checked before anything is started
+        read_waypoints_file(waypoints / f"{name}.waypoints")
     out = args.out or Path("logs") / f"gcs-{time.strftime('%Y%m%d-%H%M%S')}"
     config = StationConfig(
         adaptive=args.method == "ac",

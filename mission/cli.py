@@ -159,6 +159,7 @@ def _run(args) -> int:
 
         die_with_parent()
     scenario = load_scenario(args.scenario)
+    _preflight(scenario)
     if args.realtime and not 0 < args.speedup <= 1000:
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
     stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -223,7 +224,10 @@ def _batch(args) -> int:
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods or any(m not in ("ac", "nac") for m in methods):
         raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
-    names = [load_scenario(s).name for s in args.scenarios]
+    scenarios = [load_scenario(s) for s in args.scenarios]
+    for scenario in scenarios:
+        _preflight(scenario)
+    names = [s.name for s in scenarios]
     if len(set(names)) != len(names):
         raise InputError("command line", "SCENARIO", f"the same scenario twice: {names}")
     trials = [
@@ -244,6 +248,15 @@ def _batch(args) -> int:
         f"results in {args.out}"
     )
     return 1 if result["failed"] else 0
+
+
+def _preflight(scenario) -> None:
+    """Everything a run reads from files, checked before any process starts."""
+    from mission.plan_files import read_plan
+    from mission.structure import build_structure
+
+    build_structure(scenario.world.structure, scenario.source)  # the mesh, if any
+    read_plan(scenario)  # every vehicle's waypoint file
 
 
 def _plan(args) -> int:

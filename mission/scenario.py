@@ -81,7 +81,7 @@ def _load_layers(path: Path, depth: int) -> dict[str, Any]:
         try:
             base_path = resolve_scenario_path(base_name)
         except ScenarioError as error:
-            raise ScenarioError(str(path), "extends", error.problem) from None
+            raise ScenarioError(str(path), "extends", f"{error.problem}: {base_name}") from None
     base = _load_layers(base_path, depth + 1)
     return merge_settings(base, data)
 

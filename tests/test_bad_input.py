@@ -1,0 +1,222 @@
+"""Bad input everywhere: each case gives one line naming the file (or flag), the field or line
+and the problem, exit status 2, and leaves no output behind."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import ground_station.cli as gcs_cli
+import mission.cli as mission_cli
+import vehicle_sim.cli as vehicle_cli
+from mission.scenario import load_scenario
+from mission.waypoints import HEADER
+
+GOOD_ROW = "0\t1\t3\t16\t0\t0.1\t0\t0\t35.15\t136.96\t7.0\t1\n"
+
+
+def _plan_dir(tmp: Path, broken: str | None = None, content: str = "") -> Path:
+    """A copy of the shipped plan, with one file replaced by ``content``."""
+    source = Path(load_scenario("along").task.waypoints_dir)
+    target = tmp / "plan"
+    target.mkdir()
+    for path in source.glob("*.waypoints"):
+        text = content if path.stem == broken else path.read_text()
+        (target / path.name).write_text(text)
+    return target
+
+
+def _scenario(tmp: Path, body: str, name: str = "bad.yaml") -> Path:
+    path = tmp / name
+    path.write_text(f"extends: along\nname: bad\n{body}")
+    return path
+
+
+def _key(tmp: Path, content: bytes) -> Path:
+    path = tmp / "link.key"
+    path.write_bytes(content)
+    return path
+
+
+RUN = ["run"]
+CASES = [
+    # --- scenario YAML -----------------------------------------------------------------
+    (
+        "yaml-syntax",
+        lambda t: [*RUN, str(_scenario(t, "control: {horizon_steps: [\n"))],
+        ["bad.yaml"],
+    ),
+    ("yaml-not-a-mapping", lambda t: [*RUN, str(_raw(t, "- 1\n- 2\n"))], ["raw.yaml", "mapping"]),
+    (
+        "unknown-key",
+        lambda t: [*RUN, str(_scenario(t, "control: {horizon: 5}\n"))],
+        ["bad.yaml", "horizon"],
+    ),
+    (
+        "wrong-type",
+        lambda t: [*RUN, str(_scenario(t, "control: {horizon_steps: five}\n"))],
+        ["bad.yaml", "horizon_steps"],
+    ),
+    (
+        "negative-time",
+        lambda t: [*RUN, str(_scenario(t, "control: {t_pred_s: -1.0}\n"))],
+        ["bad.yaml", "t_pred_s", "positive"],
+    ),
+    (
+        "bad-choice",
+        lambda t: [*RUN, str(_scenario(t, "control: {los_penalty: nearest}\n"))],
+        ["bad.yaml", "los_penalty"],
+    ),
+    (
+        "zero-sigma-limit",
+        lambda t: [*RUN, str(_scenario(t, "control: {support_max_sigma0_m: 0}\n"))],
+        ["bad.yaml", "support_max_sigma0_m"],
+    ),
+    (
+        "nan-number",
+        lambda t: [*RUN, str(_scenario(t, "gnss: {sigma_uere_m: .nan}\n"))],
+        ["bad.yaml", "sigma_uere_m"],
+    ),
+    (
+        "bad-epoch",
+        lambda t: [*RUN, str(_scenario(t, "run: {epoch_utc: yesterday}\n"))],
+        ["bad.yaml", "epoch_utc"],
+    ),
+    (
+        "extends-missing",
+        lambda t: [*RUN, str(_raw(t, "extends: nowhere.yaml\nname: x\n"))],
+        ["nowhere"],
+    ),
+    (
+        "extends-itself",
+        lambda t: [*RUN, str(_raw(t, "extends: raw.yaml\nname: x\n"))],
+        ["raw.yaml"],
+    ),
+    (
+        "mesh-missing",
+        lambda t: [*RUN, str(_scenario(t, "world: {structure: {mesh_file: gone.stl}}\n"))],
+        ["gone.stl"],
+    ),
+    (
+        "mesh-garbage",
+        lambda t: [*RUN, str(_mesh(t, b"\x00\x01not a mesh at all" * 3))],
+        ["junk.stl"],
+    ),
+    (
+        "mesh-no-faces",
+        lambda t: [*RUN, str(_mesh(t, b"v 0 0 0\nv 1 0 0\n", "flat.obj"))],
+        ["flat.obj"],
+    ),
+    (
+        "plan-dir-missing",
+        lambda t: [*RUN, str(_scenario(t, "task: {waypoints_dir: nowhere}\n"))],
+        ["nowhere"],
+    ),
+    # --- waypoint files ----------------------------------------------------------------
+    ("wpl-header", lambda t: _wpl(t, "QGC WPL 100\n" + GOOD_ROW), ["work.waypoints", "line 1"]),
+    ("wpl-empty", lambda t: _wpl(t, ""), ["work.waypoints"]),
+    (
+        "wpl-columns",
+        lambda t: _wpl(t, HEADER + "\n" + GOOD_ROW + "2\t0\t3\n"),
+        ["work.waypoints", "line 3"],
+    ),
+    (
+        "wpl-not-a-number",
+        lambda t: _wpl(t, HEADER + "\n" + GOOD_ROW.replace("35.15", "north")),
+        ["work.waypoints", "line 2"],
+    ),
+    (
+        "wpl-latitude",
+        lambda t: _wpl(t, HEADER + "\n" + GOOD_ROW.replace("35.15", "135.15")),
+        ["work.waypoints", "line 2"],
+    ),
+    (
+        "wpl-gcs-file",
+        lambda t: ["--waypoints", str(_plan_dir(t, "support-2", "garbage\n"))],
+        ["support-2.waypoints", "line 1"],
+    ),
+    # --- command-line arguments --------------------------------------------------------
+    ("run-method", lambda t: [*RUN, "--method", "best"], ["--method"]),
+    ("run-speedup", lambda t: [*RUN, "--realtime", "--speedup", "0"], ["--speedup"]),
+    ("run-link-loss", lambda t: [*RUN, "--link-loss", "1.5"], ["--link-loss"]),
+    ("run-link-delay", lambda t: [*RUN, "--link-delay-ms", "-3"], ["--link-delay-ms"]),
+    ("run-observer", lambda t: [*RUN, "--observer", "qgc"], ["--observer"]),
+    ("batch-trials", lambda t: ["batch", "--trials", "0"], ["--trials"]),
+    ("batch-methods", lambda t: ["batch", "--methods", "ac,best"], ["--methods"]),
+    ("world-at-nan", lambda t: ["world", "--at", "1", "2", "nan"], ["--at"]),
+    ("world-plot-suffix", lambda t: ["world", "--plot", str(t / "out" / "w.jpg")], ["--plot"]),
+    ("scenario-name", lambda t: [*RUN, "nowhere-scenario"], ["nowhere-scenario"]),
+    ("gcs-vehicles", lambda t: ["--vehicles", "work=localhost"], ["--vehicles"]),
+    ("vehicle-name", lambda t: ["--vehicle", "support-x"], ["support-x"]),
+    ("vehicle-speedup", lambda t: ["--vehicle", "work", "--speedup", "-1"], ["--speedup"]),
+    # --- signing keys ------------------------------------------------------------------
+    ("key-missing", lambda t: [*RUN, "--signing-key", str(t / "none.key")], ["none.key"]),
+    (
+        "key-short",
+        lambda t: [*RUN, "--signing-key", str(_key(t, b"0" * 31))],
+        ["link.key", "31 bytes"],
+    ),
+    (
+        "key-not-hex",
+        lambda t: [*RUN, "--signing-key", str(_key(t, b"g" * 64))],
+        ["link.key", "hexadecimal"],
+    ),
+    (
+        "key-vehicle",
+        lambda t: ["--vehicle", "work", "--signing-key", str(_key(t, b"1" * 33))],
+        ["link.key"],
+    ),
+]
+
+
+def _raw(tmp: Path, text: str) -> Path:
+    path = tmp / "raw.yaml"
+    path.write_text(text)
+    return path
+
+
+def _mesh(tmp: Path, content: bytes, name: str = "junk.stl") -> Path:
+    (tmp / name).write_bytes(content)
+    return _scenario(tmp, f"world: {{structure: {{mesh_file: {name}, primitives: []}}}}\n")
+
+
+def _wpl(tmp: Path, content: str) -> list[str]:
+    plan = _plan_dir(tmp, "work", content)
+    return [*RUN, str(_scenario(tmp, f"task: {{waypoints_dir: {plan.name}}}\n"))]
+
+
+def _entry(case: str):
+    if case.startswith(("gcs-", "wpl-gcs")):
+        return gcs_cli.entry_point
+    if case.startswith(("vehicle-", "key-vehicle")):
+        return vehicle_cli.entry_point
+    return mission_cli.entry_point
+
+
+def test_the_table_covers_every_kind_of_input():
+    assert len(CASES) >= 25
+    kinds = {c[0].split("-")[0] for c in CASES}
+    assert {"yaml", "wpl", "mesh", "run", "key"} <= kinds
+
+
+@pytest.mark.parametrize(("case", "argv", "expected"), CASES, ids=[c[0] for c in CASES])
+def test_bad_input_gives_one_line_status_2_and_no_output(
+    case, argv, expected, tmp_path, monkeypatch, capsys
+):
+    monkeypatch.chdir(tmp_path)  # default output directories would land here
+    arguments = argv(tmp_path)
+    (tmp_path / "out").mkdir()
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    try:
+        status = _entry(case)(arguments)
+    except SystemExit as exit_:  # argparse usage errors
+        status = exit_.code
+    err = capsys.readouterr().err
+    assert status == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    for text in expected:
+        assert text in lines[0], lines[0]
+    assert "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == before, "no output left behind"
