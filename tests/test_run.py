@@ -156,3 +156,57 @@ def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_p
     assert 0.1 * sent < link["dropped_out"] < 0.4 * sent
     assert link["tick_resends"] > 0
     assert _children_of(scenario) == []
+
+
+def test_an_observer_sees_every_vehicle_without_disturbing_the_run(scenario, tmp_path):
+    import os
+    import socket
+
+    os.environ.setdefault("MAVLINK20", "1")
+    from pymavlink import mavutil
+
+    probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    probe.bind(("127.0.0.1", 0))
+    port = probe.getsockname()[1]
+    probe.close()
+    observer = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", dialect="ardupilotmega")
+    out = tmp_path / "observed"
+    run = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "mission",
+            "run",
+            str(scenario),
+            "--out",
+            str(out),
+            "--seed",
+            "2",
+            "--realtime",
+            "--speedup",
+            "10",
+            "--observer",
+            f"127.0.0.1:{port}",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    seen: dict[int, set[str]] = {}
+    try:
+        while run.poll() is None:
+            message = observer.recv_match(blocking=True, timeout=0.2)
+            if message is not None and message.get_type() != "BAD_DATA":
+                seen.setdefault(message.get_srcSystem(), set()).add(message.get_type())
+        _, stderr = run.communicate(timeout=60)
+    finally:
+        if run.poll() is None:
+            run.kill()
+        observer.close()
+    assert run.returncode == 0, stderr
+    assert json.loads((out / "summary.json").read_text())["completed"] is True
+    assert set(seen) == {1, 2, 3, 4}
+    for system in (2, 3, 4):
+        assert {"HEARTBEAT", "GPS_RAW_INT", "LANDING_TARGET", "GLOBAL_POSITION_INT"} <= seen[system]
+    assert _children_of(scenario) == []
