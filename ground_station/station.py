@@ -11,6 +11,7 @@ import socket
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -247,6 +248,8 @@ class GroundStation:
                 completion = self.sim_time_s
                 self._announce(f"Mission complete at {completion:.1f} s")
                 break
+        if models.pool is not None:
+            models.pool.shutdown()
         self._snapshot(models.g, "final")
         self.tlog.flush()
         self._write_link_stats()
@@ -456,8 +459,9 @@ def build_models(
         waypoints["work"],
         supports,
         g,
-        SupportMpc(scn.control, grid, world.camera, g.initial),
+        SupportMpc(scn.control, grid, world.camera, g.initial, instances=len(supports)),
         np.random.default_rng(seed),
+        ThreadPoolExecutor(max_workers=len(supports), thread_name_prefix="support-mpc"),
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),
