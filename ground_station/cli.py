@@ -8,9 +8,14 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from mission.cli_common import OneLineArgumentParser, die_with_parent, run_guarded
+from mission.cli_common import (
+    OneLineArgumentParser,
+    add_link_arguments,
+    die_with_parent,
+    link_settings,
+    run_guarded,
+)
 from mission.errors import InputError
-from mission.link_impairment import LinkSettings
 from mission.mavlink_udp import parse_address
 from mission.plan_files import vehicle_names
 from mission.signing import read_signing_key
@@ -64,20 +69,7 @@ def build_parser() -> OneLineArgumentParser:
     parser.add_argument(
         "--speedup", type=float, help="real time, this many times faster (default: lockstep)"
     )
-    parser.add_argument(
-        "--link-loss",
-        type=float,
-        default=0.0,
-        metavar="P",
-        help="drop each datagram sent with probability P (seeded; testing)",
-    )
-    parser.add_argument(
-        "--link-delay-ms",
-        type=float,
-        default=0.0,
-        metavar="D",
-        help="delay each datagram sent by D milliseconds (testing)",
-    )
+    add_link_arguments(parser)
     parser.add_argument(
         "--signing-key",
         type=Path,
@@ -94,15 +86,6 @@ def read_waypoints_file(path: Path) -> None:
     if not path.is_file():
         raise InputError(str(path), "", "no such waypoint file")
     read_waypoints(path)
-
-
-def link_settings(args) -> LinkSettings:
-    """--link-loss and --link-delay-ms, checked."""
-    try:
-        return LinkSettings(args.link_loss, args.link_delay_ms)
-    except ValueError as error:
-        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
-        raise InputError("command line", flag, str(error).split(" must ", 1)[-1]) from None
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -10,7 +10,13 @@ from pathlib import Path
 
 import numpy as np
 
-from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
+from mission.cli_common import (
+    OneLineArgumentParser,
+    add_link_arguments,
+    link_settings,
+    parse_point,
+    run_guarded,
+)
 from mission.errors import InputError
 from mission.world import World
 
@@ -89,12 +95,7 @@ def build_parser() -> OneLineArgumentParser:
         metavar="HOST:PORT",
         help="every vehicle also streams here (QGroundControl, MAVProxy); use with --realtime",
     )
-    run.add_argument(
-        "--link-loss", type=float, default=0.0, metavar="P", help="drop datagrams (every link)"
-    )
-    run.add_argument(
-        "--link-delay-ms", type=float, default=0.0, metavar="D", help="delay datagrams (ms)"
-    )
+    add_link_arguments(run)
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
     batch = commands.add_parser(
@@ -175,13 +176,7 @@ def _run(args) -> int:
             parse_address(args.observer, "--observer")
         except ValueError as error:
             raise InputError("command line", "--observer", str(error)) from None
-    from mission.link_impairment import LinkSettings
-
-    try:
-        link = LinkSettings(args.link_loss, args.link_delay_ms)
-    except ValueError as error:
-        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
-        raise InputError("command line", flag, str(error).split(" must ", 1)[-1]) from None
+    link = link_settings(args)
     options = RunOptions(
         args.scenario,
         args.method,

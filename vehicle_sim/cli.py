@@ -8,9 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mission.cli_common import OneLineArgumentParser, parse_point, run_guarded
+from mission.cli_common import (
+    OneLineArgumentParser,
+    add_link_arguments,
+    link_settings,
+    parse_point,
+    run_guarded,
+)
 from mission.errors import InputError
-from mission.link_impairment import LinkSettings
 from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.plan_files import read_vehicle_waypoints
 from mission.signing import read_signing_key
@@ -62,20 +67,7 @@ def build_parser() -> OneLineArgumentParser:
         metavar="HOST:PORT",
         help="work: send truth here (default: each support's default truth port)",
     )
-    parser.add_argument(
-        "--link-loss",
-        type=float,
-        default=0.0,
-        metavar="P",
-        help="drop each datagram sent with probability P (seeded; testing)",
-    )
-    parser.add_argument(
-        "--link-delay-ms",
-        type=float,
-        default=0.0,
-        metavar="D",
-        help="delay each datagram sent by D milliseconds (testing)",
-    )
+    add_link_arguments(parser)
     parser.add_argument(
         "--signing-key",
         type=Path,
@@ -88,15 +80,6 @@ def build_parser() -> OneLineArgumentParser:
         help="stop when the process that started this one dies",
     )
     return parser
-
-
-def link_settings(args) -> LinkSettings:
-    """--link-loss and --link-delay-ms, checked."""
-    try:
-        return LinkSettings(args.link_loss, args.link_delay_ms)
-    except ValueError as error:
-        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
-        raise InputError("command line", flag, str(error).split(" must ", 1)[-1]) from None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
