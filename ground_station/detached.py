@@ -28,12 +28,21 @@ class DetachedRun:
 
 
 def run_detached(
-    world: World, waypoints: dict[str, np.ndarray], adaptive: bool, seed: int, max_cycles: int
+    world: World,
+    waypoints: dict[str, np.ndarray],
+    adaptive: bool,
+    seed: int,
+    max_cycles: int,
+    parallel: bool = True,
 ) -> DetachedRun:
-    """Run up to ``max_cycles`` control cycles (or to completion)."""
+    """Run up to ``max_cycles`` control cycles (or to completion); ``parallel=False`` solves
+    the supports' MPCs one after another (to time single solves without contention)."""
     scenario = world.scenario
     control = scenario.control
     models, state = build_models(world, waypoints, adaptive, seed)
+    if not parallel and models.pool is not None:
+        models.pool.shutdown()
+        models.pool = None
     rng = np.random.default_rng([seed, 99])
     vehicles = {name: Kinematics.at(points[0]) for name, points in waypoints.items()}
     speed = {
@@ -65,4 +74,6 @@ def run_detached(
             vehicle.step(control.t_cont_s, speed[name], rng, scenario.vehicle.tracking_noise_m)
         if state.completed:
             break
+    if models.pool is not None:
+        models.pool.shutdown()
     return DetachedRun(outputs, np.array(truth), state.completed)

@@ -149,7 +149,8 @@ def _wait(queue: MessageQueue, match: Callable, timeout_s: float = 5.0) -> None:
 
 
 def bench_ground_station(cycles: int = 160, scipy_problems: int = 5) -> list[BenchResult]:
-    """MPC solve times and cycle time over a detached Along run (AC); scipy vs casadi."""
+    """MPC solve times (supports one after another) and cycle time (in parallel) over a
+    detached Along run (AC); scipy vs casadi."""
     import numpy as np
 
     from ground_station.detached import run_detached
@@ -162,8 +163,9 @@ def bench_ground_station(cycles: int = 160, scipy_problems: int = 5) -> list[Ben
         "work": plan.work,
         **{f"support-{n + 1}": plan.supports[n] for n in range(len(plan.supports))},
     }
+    one_by_one = run_detached(world, waypoints, True, 0, cycles, parallel=False)
+    solves = [p.solve_ms for o in one_by_one.outputs for p in o.support_plans.values()]
     run = run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
-    solves = [p.solve_ms for o in run.outputs for p in o.support_plans.values()]
     cycle = statistics.median(o.cycle_ms for o in run.outputs)
     ratio = _scipy_over_casadi(world, plan, scipy_problems)
     median, p95 = statistics.median(solves), float(np.percentile(solves, 95))

@@ -79,15 +79,18 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         names = vehicle_names(scenario.task.supports)
         ports: dict[str, int] = {}
         truth_ports: list[int] = []
-        for name in names[1:]:
-            child = _start(
+        supports = [  # started together: they do not depend on each other
+            _start(
                 options.out_dir,
                 name,
                 ["-m", "vehicle_sim", "--vehicle", name, "--port", "0", *observer, *common],
             )
-            children.append(child)
+            for name in names[1:]
+        ]
+        children.extend(supports)
+        for child in supports:
             port, truth = _wait_banner(child)
-            ports[name] = port
+            ports[child.name] = port
             truth_ports.append(truth)
         truth_out = [a for p in truth_ports for a in ("--truth-out", f"127.0.0.1:{p}")]
         work = _start(
