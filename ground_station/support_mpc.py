@@ -242,8 +242,7 @@ class SupportMpc:
         anchors = self.anchors(guess, work, targets, blocked)
         flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window])
         path, status, cost = self._solve_once(solver, fixed, flags, guess)
-        stuck = np.linalg.norm(path[-1] - yhat) < self.grid.voxel_m
-        if escape and stuck:  # G_s is flat at voxel centres: also start from paths leaving
+        if escape:  # G_s is flat at voxel centres: also start from paths leaving each way
             for candidate in self._escape_guesses(yhat):
                 tried = self._solve_once(solver, fixed, flags, candidate)
                 if tried[2] < cost - 1e-9:
