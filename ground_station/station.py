@@ -37,6 +37,10 @@ GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190
 POSITION_ONLY = 0b0000_1101_1111_1000
 SNAPSHOT_EVERY = 20
+GUIDED_AND_ARMED = (  # DO_SET_MODE custom mode 4 (GUIDED), then arm
+    (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
+    (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1,)),
+)
 COMMAND_TIMEOUT_WALL_S = 5.0  # a command is repeated until acknowledged, this long at most
 
 
@@ -192,18 +196,10 @@ class GroundStation:
     def arm_all(self) -> None:
         """GUIDED and armed, each acknowledged."""
         for view in self.views.values():
-            for command, params in (
-                (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
-                (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1, 0)),
-            ):
+            for command, params in GUIDED_AND_ARMED:
                 deadline = time.monotonic() + COMMAND_TIMEOUT_WALL_S
                 while not _acked(view, command) and time.monotonic() < deadline:
-                    self.send(
-                        mavlink2.MAVLink_command_long_message(
-                            view.system_id, 1, command, 0, *params, 0, 0, 0, 0, 0
-                        ),
-                        view,
-                    )
+                    self._command_long(view, command, params)
                     self.pump(4 * self.retry_wall_s, lambda v=view, c=command: _acked(v, c))
                 if not _acked(view, command):
                     raise StationError(f"{view.name} did not accept command {command}")
@@ -328,16 +324,14 @@ class GroundStation:
 
     def _rejoin(self, view: VehicleView) -> None:
         """GUIDED and arm a vehicle that came back (its ACKs arrive with later steps)."""
-        for command, params in (
-            (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
-            (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1, 0)),
-        ):
-            self.send(
-                mavlink2.MAVLink_command_long_message(
-                    view.system_id, 1, command, 0, *params, 0, 0, 0, 0, 0
-                ),
-                view,
-            )
+        for command, params in GUIDED_AND_ARMED:
+            self._command_long(view, command, params)
+
+    def _command_long(self, view: VehicleView, command: int, params: tuple[float, ...]) -> None:
+        values = [*params, *[0.0] * (7 - len(params))]
+        self.send(
+            mavlink2.MAVLink_command_long_message(view.system_id, 1, command, 0, *values), view
+        )
 
     def _current(self, name: str, kind: str) -> Any | None:
         """The vehicle's message of this kind from the current step (None if late or missing)."""

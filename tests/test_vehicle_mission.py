@@ -186,3 +186,15 @@ def test_messages_for_another_system_are_ignored(client, waypoint_file):
     client.send(mavlink2.MAVLink_mission_clear_all_message(SYSID + 5, 1, MISSION))
     assert _ack(client) is None
     assert _rows(mission.download()) == _rows(items)
+
+
+def test_the_last_item_sent_again_gets_the_final_ack_again(client, waypoint_file):
+    """When the vehicle's final MISSION_ACK is lost, the ground station repeats the last item:
+    the vehicle must acknowledge again, not report a sequence error."""
+    items = [row.to_item() for row in read_waypoints(waypoint_file)]
+    mission = _mission_client(client)
+    assert mission.upload(items) == mavlink2.MAV_MISSION_ACCEPTED
+    client.send(items[-1].to_int_message((SYSID, 1)))
+    assert _ack(client) == mavlink2.MAV_MISSION_ACCEPTED
+    client.send(items[-2].to_int_message((SYSID, 1)))  # any other item is still an error
+    assert _ack(client) == mavlink2.MAV_MISSION_INVALID_SEQUENCE
