@@ -263,6 +263,7 @@ class GroundStation:
         stats = {
             "loss": self.config.link.loss,
             "delay_ms": self.config.link.delay_ms,
+            "sent_out": link.attempted if link is not None else None,
             "dropped_out": link.dropped if link is not None else 0,
             **self.link_stats,
             "rejected": dict(self.endpoint.counters.rejected),

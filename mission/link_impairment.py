@@ -46,6 +46,7 @@ class ImpairedLink:
         self.sock = sock
         self.settings = settings
         self.rng = np.random.default_rng(seed)
+        self.attempted = 0
         self.dropped = 0
         self.delayed = 0
         self.send_errors = 0
@@ -60,6 +61,7 @@ class ImpairedLink:
 
     def send(self, datagram: bytes, destination: Address) -> bool:
         """Send (or drop, or queue) one datagram; False if it was dropped or failed."""
+        self.attempted += 1
         if self.settings.loss > 0 and self.rng.random() < self.settings.loss:
             self.dropped += 1
             return False
