@@ -5,8 +5,10 @@ from __future__ import annotations
 import csv
 import io
 import json
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -140,9 +142,6 @@ def test_a_three_seed_paired_along_batch_ac_beats_nac_on_every_seed(tmp_path):
 
 
 def test_a_terminated_batch_leaves_no_process_behind(tmp_path):
-    import signal
-    import time
-
     out = tmp_path / "stopped"
     batch = subprocess.Popen(
         [
