@@ -18,7 +18,6 @@ from mission.cli_common import (
     run_guarded,
 )
 from mission.errors import InputError
-from mission.world import World
 
 DEFAULT_SCENARIO = "along"
 DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
@@ -131,6 +130,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _world(args) -> int:
     point = parse_point(args.at, "--at") if args.at is not None else None
+    from mission.world import World
+
     if args.plot is not None:
         _check_output_path(args.plot, "--plot", ".png")
     world = World.load(args.scenario)
@@ -248,15 +249,18 @@ def _batch(args) -> int:
 def _preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts."""
     from mission.plan_files import read_plan
-    from mission.structure import build_structure
+    from mission.structure import load_mesh_file
 
-    build_structure(scenario.world.structure, scenario.source)  # the mesh, if any
+    mesh_file = scenario.world.structure.mesh_file
+    if mesh_file is not None:
+        load_mesh_file(Path(mesh_file), scenario.source)
     read_plan(scenario)  # every vehicle's waypoint file
 
 
 def _plan(args) -> int:
     from mission.plan_files import write_plan
     from mission.planner import plan_supports
+    from mission.world import World
     from mission.zone_placement import place_along, place_wall
 
     if args.plot is not None:
@@ -312,6 +316,7 @@ def _analyze(args) -> int:
     if args.plots:
         from mission.analysis import read_tlog
         from mission.run_plot import plot_run
+        from mission.world import World
 
         trace = read_tlog(tlog, scenario)
         for path in plot_run(trace, World(scenario), tlog.parent / "g", tlog.parent / "plots"):

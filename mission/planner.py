@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 
 from mission.errors import InputError
 from mission.grid import VoxelGrid
@@ -90,6 +89,8 @@ def _admissible_points(world: World) -> tuple[np.ndarray, np.ndarray]:
     keep &= ~world.structure.contains(lattice)
     lattice = lattice[keep]
     if settings.clearance_m > 0:
+        import trimesh  # only planning needs it; the run's processes import this module
+
         _, distance, _ = trimesh.proximity.closest_point(world.structure.mesh, lattice)
         lattice = lattice[distance >= settings.clearance_m]
     sigma0 = world.gnss.sigma0(lattice)

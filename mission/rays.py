@@ -7,8 +7,9 @@ independent answer the tests compare with.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import trimesh
 
 try:  # embreex ships wheels for x86-64 only
     from embreex import rtcore_scene
@@ -16,20 +17,23 @@ try:  # embreex ships wheels for x86-64 only
 except ImportError:  # pragma: no cover - exercised on machines without embreex
     rtcore_scene = None
 
+if TYPE_CHECKING:
+    import trimesh
+
 
 class EmbreeRays:
     """Occlusion through an Embree scene (coordinates shifted to the mesh's corner)."""
 
     name = "Embree"
 
-    def __init__(self, mesh: trimesh.Trimesh) -> None:
-        vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray) -> None:
+        vertices = np.asarray(vertices, dtype=np.float64)
         self._origin = vertices.min(axis=0)
         self._scene = rtcore_scene.EmbreeScene()
         TriangleMesh(
             scene=self._scene,
             vertices=(vertices - self._origin).astype(np.float32),
-            indices=np.asarray(mesh.faces, dtype=np.int32),
+            indices=np.asarray(faces, dtype=np.int32),
         )
 
     def occluded(
@@ -54,6 +58,8 @@ class TrimeshRays:
     name = "trimesh"
 
     def __init__(self, mesh: trimesh.Trimesh) -> None:
+        import trimesh
+
         self._intersector = trimesh.ray.ray_triangle.RayMeshIntersector(mesh)
 
     def occluded(
@@ -72,6 +78,10 @@ class TrimeshRays:
         return blocked
 
 
-def best_ray_engine(mesh: trimesh.Trimesh) -> EmbreeRays | TrimeshRays:
+def best_ray_engine(vertices: np.ndarray, faces: np.ndarray) -> EmbreeRays | TrimeshRays:
     """Embree when available, trimesh otherwise."""
-    return EmbreeRays(mesh) if rtcore_scene is not None else TrimeshRays(mesh)
+    if rtcore_scene is not None:
+        return EmbreeRays(vertices, faces)
+    import trimesh
+
+    return TrimeshRays(trimesh.Trimesh(vertices, faces, process=False))
