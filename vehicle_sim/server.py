@@ -80,7 +80,9 @@ class VehicleServer:
         self._pending_deadline: float | None = None
         self._parent = os.getppid()
         self._batch: list[Any] | None = None
-        self._last_step: list[bytes] = []  # the last step's datagrams, for a repeated tick
+        # The last step's messages, for a repeated tick: encoded afresh when asked again, since
+        # a signed link refuses a replayed packet (its signature timestamp must increase).
+        self._last_step: list[Any] = []
 
     def attach(self, vehicle: Vehicle) -> None:
         """Connect the vehicle whose messages this server carries."""
@@ -104,7 +106,8 @@ class VehicleServer:
             self.vehicle.publish(truth)
         finally:
             batch, self._batch = self._batch, None
-            self._last_step = self.endpoint.send_many(batch, [*self.peers, *self.outs])
+            self.endpoint.send_many(batch, [*self.peers, *self.outs])
+            self._last_step = batch
 
     # -- main loop --------------------------------------------------------------------------
     def run(self) -> None:
@@ -171,7 +174,7 @@ class VehicleServer:
         assert vehicle is not None
         if self._last_step and abs(time_s - vehicle.sim_time_s) < 1e-9:
             if self._pending_deadline is None:
-                self.endpoint.resend(self._last_step, [sender])
+                self.endpoint.send_many(self._last_step, [sender])
                 self.stats.resent_steps += 1
             return
         if not self._started and vehicle.steps == 0 and time_s > vehicle.step_s + 1e-9:
