@@ -103,6 +103,20 @@ def test_an_unfinished_or_foreign_run_directory_does_not_count(tmp_path):
     assert finished_summary(tmp_path, trial) is None
 
 
+def test_rerunning_an_unfinished_run_starts_from_an_empty_directory(tmp_path):
+    """What an interrupted run left (a partial tlog, no summary) is wiped before it reruns."""
+    from mission.batch import _start_run
+
+    run_dir = tmp_path / "runs" / "along-ac-0"
+    run_dir.mkdir(parents=True)
+    (run_dir / "gcs.tlog").write_bytes(b"partial")
+    missing = str(tmp_path / "no-such-scenario.yaml")  # the child fails at once: no real run
+    process = _start_run(Trial(missing, "along", "ac", 0), run_dir)
+    assert process.wait(timeout=60) != 0
+    assert sorted(path.name for path in run_dir.iterdir()) == ["mission.log"]
+    assert "no-such-scenario.yaml" in (run_dir / "mission.log").read_text()
+
+
 def _batch(out: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [

@@ -169,3 +169,48 @@ def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp
     assert "Traceback" not in (out / "ground_station.log").read_text()
     trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
     assert {s for s, _ in trace.truth} == {1, 2, 3, 4}  # nothing forged reached the log
+
+
+@pytest.mark.parametrize("parent_is_named", [True, False])
+def test_a_child_whose_named_parent_is_gone_stops_itself(parent_is_named):
+    """die_with_parent: prctl cannot cover a parent that died before the child called it, so
+    the child compares its parent with the one named in MISSION_PARENT_PID and stops."""
+    import os
+
+    from mission.cli_common import PARENT_PID_VARIABLE
+
+    code = "from mission.cli_common import die_with_parent; die_with_parent(); print('alive')"
+    named = os.getpid() if parent_is_named else 1  # pid 1 is never this child's parent here
+    env = {**os.environ, PARENT_PID_VARIABLE: str(named)}
+    child = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=60
+    )
+    if parent_is_named:
+        assert (child.returncode, child.stdout) == (0, "alive\n")
+    else:
+        assert (child.returncode, child.stdout) == (-signal.SIGTERM, "")
+
+
+def test_a_silent_work_uav_ends_the_run_from_the_ground_station(scenario, tmp_path):
+    """A frozen (not dead) work vehicle: the orchestrator sees no exit, so the ground station
+    must notice the silence itself (3 s of simulated time) and end the run naming it."""
+    out = tmp_path / "run"
+    run = _start_run(scenario, out)
+    work: list[str] = []
+    try:
+        _wait_cycles(out, 40)
+        work = _pids(f"--vehicle work .*{scenario}")
+        assert len(work) == 1
+        subprocess.run(["kill", "-STOP", *work], check=True)
+        _, stderr = run.communicate(timeout=120)
+    finally:
+        if work:
+            subprocess.run(["kill", "-CONT", *work], capture_output=True)
+        if run.poll() is None:
+            run.send_signal(signal.SIGKILL)
+    assert run.returncode == 1
+    assert "ground_station exited with status 1" in stderr
+    assert "work lost: no message for 3.0 s" in (out / "ground_station.log").read_text()
+    trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
+    assert len(trace.ticks) >= 40
+    assert _pids(str(scenario)) == []
