@@ -95,8 +95,15 @@ def test_with_g_raised_around_the_uav_the_plan_leaves_the_region(setting):
     assert np.all(steps <= setting[0].scenario.control.d_max_support_m + 0.05)
 
 
-def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
-    """The casadi model equals an independent numpy cost; SLSQP finds the same optimum."""
+@pytest.mark.parametrize(
+    "offset",
+    [(0.3, -0.2, 0.1), (-7.0, 0.0, 0.0)],
+    ids=["terminal-in-reach", "terminal-out-of-reach"],
+)
+def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting, offset):
+    """The casadi model equals an independent numpy cost (xi with its jump at d_max); SLSQP
+    finds the same optimum, whether it ends within d_max of the terminal waypoint (the near
+    branch) or, with the terminal out of reach, beyond it (the far branch)."""
     from scipy.optimize import minimize
 
     from ground_station.support_mpc import support_cost_numpy
@@ -104,10 +111,13 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
     world, plan, grid, mpc = setting
     control = world.scenario.control
     g = world.sigma0_map().sigma_m
-    yhat = plan.supports[0][3] + np.array([0.3, -0.2, 0.1])
+    yhat = plan.supports[0][3] + np.array(offset)
     work = predict_work(plan.work[3], 4, plan.work, 5, control.d_max_work_m, control.arrival_tol_m)
     result = mpc.solve(yhat, plan.supports[0], work.path, work.indices, g, world.camera.observable)
     targets, terminal = plan.supports[0][work.indices[:5]], plan.supports[0][work.indices[5]]
+    out_of_reach = np.linalg.norm(terminal - yhat) > 6 * control.d_max_support_m
+    ends_far = np.linalg.norm(terminal - result.path[-1]) > control.d_max_support_m
+    assert ends_far == out_of_reach
 
     def cost(x):
         return support_cost_numpy(
@@ -128,7 +138,10 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
         steps = np.vstack([v[0] - yhat, np.diff(v, axis=0)])
         return control.d_max_support_m**2 - np.sum(steps**2, axis=1)
 
-    start = mpc._initial_guess(yhat, terminal, None).ravel()
+    # A feasible start: even fractions of the way to the terminal, at most d_max a step.
+    distance = np.linalg.norm(terminal - yhat)
+    fraction = min(1 / 6, control.d_max_support_m / distance)
+    start = (yhat + (terminal - yhat) * fraction * np.arange(1, 6)[:, None]).ravel()
     reference = minimize(
         cost,
         start,
@@ -136,9 +149,13 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting):
         options={"maxiter": 300, "ftol": 1e-12},
         constraints=[{"type": "ineq", "fun": steps_left}],
     )
-    assert reference.success
+    # Status 8: SLSQP found no descent direction at its finite-difference precision (far
+    # from the terminal the w_penalty term makes the cost ~500); the point is still checked.
+    assert reference.success or reference.status == 8, reference.message
     np.testing.assert_allclose(reference.x.reshape(-1, 3), result.path, atol=0.01)
-    assert cost(result.path.ravel()) == pytest.approx(reference.fun, rel=1e-6)
+    ours = cost(result.path.ravel())
+    assert ours == pytest.approx(reference.fun, rel=1e-5)
+    assert ours <= reference.fun * (1 + 1e-7)  # IPOPT's optimum is at least as good
 
 
 def test_building_the_mpc_leaves_no_files_in_the_working_directory(
