@@ -290,7 +290,7 @@ class SupportMpc:
     def _solve_once(self, solver, fixed: np.ndarray, flags: np.ndarray, guess: np.ndarray):
         """The minimum over both branches of the terminal xi: (path, status, true cost)."""
         c, horizon = self.control, self.horizon
-        yhat, terminal = fixed[:3], fixed[3 + 3 * horizon : 6 + 3 * horizon]
+        yhat, terminal = fixed[:3], self._terminal_of(fixed)
         reach = (horizon + 1) * c.d_max_support_m
         best = None
         if np.linalg.norm(terminal - yhat) <= reach:
@@ -315,12 +315,18 @@ class SupportMpc:
         )
         status = solver.stats()["return_status"]
         path = np.array(result["x"]).reshape(self.horizon, 3)
-        terminal_sq = float(
-            np.sum((fixed[3 + 3 * self.horizon : 6 + 3 * self.horizon] - path[-1]) ** 2)
-        )
-        true_weight = c.w_interval if terminal_sq <= c.d_max_support_m**2 else c.w_penalty
-        cost = float(result["f"]) + (true_weight - weight) * terminal_sq
+        terminal_sq = float(np.sum((self._terminal_of(fixed) - path[-1]) ** 2))
+        cost = float(result["f"]) + (self._xi_weight(terminal_sq) - weight) * terminal_sq
         return path, status, cost
+
+    def _terminal_of(self, fixed: np.ndarray) -> np.ndarray:
+        """The terminal waypoint w_{n,k_{U+1}} inside the fixed parameters."""
+        return fixed[3 + 3 * self.horizon : 6 + 3 * self.horizon]
+
+    def _xi_weight(self, terminal_sq: float) -> float:
+        """The paper's xi weight at a squared distance: w_interval up to d_max, else w_penalty."""
+        c = self.control
+        return c.w_interval if terminal_sq <= c.d_max_support_m**2 else c.w_penalty
 
     def anchors(
         self, guess: np.ndarray, work: np.ndarray, targets: np.ndarray, blocked: np.ndarray
@@ -358,7 +364,7 @@ class SupportMpc:
         heading straight for the terminal waypoint: the ESCAPE_STARTS of the six that cost
         least where they start."""
         horizon, d_max = self.horizon, self.control.d_max_support_m
-        terminal = fixed[3 + 3 * horizon : 6 + 3 * horizon]
+        terminal = self._terminal_of(fixed)
         out = (horizon + 1) // 2
         paths = []
         for direction in np.vstack([np.eye(3), -np.eye(3)]):
@@ -370,9 +376,8 @@ class SupportMpc:
 
     def cost(self, fixed: np.ndarray, flags: np.ndarray, path: np.ndarray) -> float:
         """The true cost of ``path`` (terminal xi on its side of d_max)."""
-        c, horizon = self.control, self.horizon
-        terminal_sq = float(np.sum((fixed[3 + 3 * horizon : 6 + 3 * horizon] - path[-1]) ** 2))
-        weight = c.w_interval if terminal_sq <= c.d_max_support_m**2 else c.w_penalty
+        terminal_sq = float(np.sum((self._terminal_of(fixed) - path[-1]) ** 2))
+        weight = self._xi_weight(terminal_sq)
         return float(self._cost(path.ravel(), np.concatenate([fixed, [weight], flags])))
 
 
