@@ -70,8 +70,13 @@ def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
 def read_tlog_with_mavutil(tlog: Path, scenario: Scenario) -> RunTrace:
     """The same as :func:`read_tlog` through pymavlink's own tlog reader (every message
     decoded; slower): the reference the fast reader is tested against."""
+    return _trace_of(_mavutil_messages(tlog), scenario)
+
+
+def _mavutil_messages(tlog: Path) -> Iterator[Any]:
+    """Every message of a tlog through pymavlink's tolerant reader."""
     log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega", robust_parsing=True)
-    return _trace_of(iter(log.recv_match, None), scenario)
+    return iter(log.recv_match, None)
 
 
 def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
@@ -115,8 +120,7 @@ def _tlog_messages(tlog: Path) -> Iterator[Any]:
     data = tlog.read_bytes()
     records = _wanted_records(data)
     if records is None:
-        log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega", robust_parsing=True)
-        yield from iter(log.recv_match, None)
+        yield from _mavutil_messages(tlog)
         return
     parser = mavlink2.MAVLink(None)
     for usec, packet in records:

@@ -37,7 +37,7 @@ def summary_text(world: World) -> str:
         "workspace  " + "  ".join(f"{'xyz'[a]} {_span(w.workspace, a)}" for a in range(3)) + " m",
         f"structure  {len(w.structure.primitives)} primitives"
         + (f" + mesh {w.structure.mesh_file}" if w.structure.mesh_file else "")
-        + f", {len(world.structure.mesh.faces)} triangles, ray engine "
+        + f", {len(world.structure.faces)} triangles, ray engine "
         + ("Embree" if world.structure.uses_embree else "trimesh (no Embree)"),
     ]
     lines += [f"  {p.name:<10} {p.min_m} .. {p.max_m}" for p in w.structure.primitives]
