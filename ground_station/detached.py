@@ -33,16 +33,11 @@ def run_detached(
     adaptive: bool,
     seed: int,
     max_cycles: int,
-    parallel: bool = True,
 ) -> DetachedRun:
-    """Run up to ``max_cycles`` control cycles (or to completion); ``parallel=False`` solves
-    the supports' MPCs one after another (to time single solves without contention)."""
+    """Run up to ``max_cycles`` control cycles (or to completion)."""
     scenario = world.scenario
     control = scenario.control
     models, state = build_models(world, waypoints, adaptive, seed)
-    if not parallel and models.pool is not None:
-        models.pool.shutdown()
-        models.pool = None
     rng = np.random.default_rng([seed, 99])
     vehicles = {name: Kinematics.at(points[0]) for name, points in waypoints.items()}
     speed = {
@@ -74,6 +69,4 @@ def run_detached(
             vehicle.step(control.t_cont_s, speed[name], rng, scenario.vehicle.tracking_noise_m)
         if state.completed:
             break
-    if models.pool is not None:
-        models.pool.shutdown()
     return DetachedRun(outputs, np.array(truth), state.completed)

@@ -11,7 +11,6 @@ import socket
 import sys
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -244,8 +243,6 @@ class GroundStation:
                 completion = self.sim_time_s
                 self._announce(f"Mission complete at {completion:.1f} s")
                 break
-        if models.pool is not None:
-            models.pool.shutdown()
         self._snapshot(models.g, "final")
         self.tlog.flush()
         self._write_link_stats()
@@ -454,9 +451,8 @@ def build_models(
         waypoints["work"],
         supports,
         g,
-        SupportMpc(scn.control, grid, world.camera, g.initial, instances=len(supports)),
+        SupportMpc(scn.control, grid, world.camera, g.initial),
         np.random.default_rng(seed),
-        ThreadPoolExecutor(max_workers=len(supports), thread_name_prefix="support-mpc"),
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),

@@ -132,7 +132,6 @@ class SupportMpc:
         grid: VoxelGrid,
         camera: CameraModel,
         sigma0: np.ndarray | None = None,
-        instances: int = 1,
     ) -> None:
         self.control = control
         self.grid = grid
@@ -148,7 +147,7 @@ class SupportMpc:
         self._build_dir = tempfile.TemporaryDirectory(
             prefix="support-mpc-", ignore_cleanup_errors=True
         )
-        self._solvers = self._build(instances)
+        self._solver = self._build()
         cube = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=3)))
         cube = cube[np.any(cube != 0, axis=1)]
         self._directions = cube / np.linalg.norm(cube, axis=1, keepdims=True)
@@ -163,8 +162,8 @@ class SupportMpc:
             "far": np.concatenate([steps, [np.inf], shadow]),
         }
 
-    def _build(self, instances: int) -> list[ca.Function]:
-        """``instances`` solvers of the same NLP (one per thread that solves concurrently)."""
+    def _build(self) -> ca.Function:
+        """The NLP's IPOPT solver, its functions compiled when a C compiler is there."""
         c, horizon = self.control, self.horizon
         sym = ca.MX
         g_s = casadi_smoothed(self._window_grid)
@@ -220,10 +219,9 @@ class SupportMpc:
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": constraints}
         interpreted = ca.nlpsol("support_mpc", "ipopt", nlp, IPOPT_OPTIONS)
         library = compiled_nlp(interpreted, self._build_dir.name)
-        problem = nlp if library is None else library
-        return [
-            ca.nlpsol(f"support_mpc_{i}", "ipopt", problem, IPOPT_OPTIONS) for i in range(instances)
-        ]
+        if library is None:
+            return interpreted
+        return ca.nlpsol("support_mpc", "ipopt", library, IPOPT_OPTIONS)
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(corner of the window in world coordinates, its values first-axis-fastest)."""
@@ -247,11 +245,10 @@ class SupportMpc:
         observable,
         warm_start: np.ndarray | None = None,
         escape: bool = False,
-        instance: int = 0,
     ) -> SupportPlan:
         """Optimise V_n (``g_values``: G as a 3-D array; ``observable(a, b)``: rows of b
-        observable from rows of a). Concurrent calls must use different ``instance``s."""
-        solver = self._solvers[instance]
+        observable from rows of a)."""
+        solver = self._solver
         horizon = self.horizon
         targets = support_waypoints[work_indices[:horizon]]
         terminal = support_waypoints[work_indices[horizon]]

@@ -151,8 +151,8 @@ def _wait(queue: MessageQueue, match: Callable, timeout_s: float = 5.0) -> None:
 def bench_ground_station(
     cycles: int = 160, scipy_problems: int = 5, repeats: int = 3
 ) -> list[BenchResult]:
-    """MPC solve times (supports one after another) and cycle time (in parallel) over a
-    detached Along run (AC), each the median over ``repeats`` runs; scipy vs casadi."""
+    """MPC solve times and cycle time over a detached Along run (AC), each the median over
+    ``repeats`` runs; scipy vs casadi."""
     import numpy as np
 
     from ground_station.detached import run_detached
@@ -167,11 +167,10 @@ def bench_ground_station(
     }
     medians, p95s, cycles_ms = [], [], []
     for _ in range(repeats):  # the same run each time: only the timings differ
-        one_by_one = run_detached(world, waypoints, True, 0, cycles, parallel=False)
-        solves = [p.solve_ms for o in one_by_one.outputs for p in o.support_plans.values()]
+        run = run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
+        solves = [p.solve_ms for o in run.outputs for p in o.support_plans.values()]
         medians.append(statistics.median(solves))
         p95s.append(float(np.percentile(solves, 95)))
-        run = run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
         cycles_ms.append(statistics.median(o.cycle_ms for o in run.outputs))
     ratio = _scipy_over_casadi(world, plan, scipy_problems)
     median, p95 = statistics.median(medians), statistics.median(p95s)
