@@ -79,6 +79,9 @@ def warped_index(u: np.ndarray | ca.MX | ca.SX, upper: np.ndarray) -> np.ndarray
     return base + 3 * t**2 - 2 * t**3
 
 
+_CORNERS = np.array(list(itertools.product((0, 1), repeat=3)))
+
+
 def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) -> np.ndarray:
     """Zero-slope cubic Hermite interpolation of voxel values at points (numpy)."""
     points = np.atleast_2d(np.asarray(points, dtype=float))
@@ -87,12 +90,14 @@ def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) 
     w = warped_index(u, (shape - 1).astype(float))
     base = np.minimum(np.floor(w).astype(int), np.maximum(shape - 2, 0))
     frac = w - base
-    result = np.zeros(len(points))
-    for corner in itertools.product((0, 1), repeat=3):
-        corner = np.array(corner)
-        index = np.minimum(base + corner, shape - 1)
-        weight = np.prod(np.where(corner == 1, frac, 1 - frac), axis=1)
-        result += weight * values[tuple(index.T)]
+    # the eight corners at once: (N, 8, 3) indices and per-axis weights
+    index = np.minimum(base[:, None, :] + _CORNERS, shape - 1)
+    factors = np.where(_CORNERS == 1, frac[:, None, :], 1 - frac[:, None, :])
+    weight = factors[..., 0] * factors[..., 1] * factors[..., 2]
+    terms = weight * values[index[..., 0], index[..., 1], index[..., 2]]
+    result = terms[:, 0].copy()
+    for corner in range(1, len(_CORNERS)):  # summed in corner order, as the loop it replaces
+        result += terms[:, corner]
     return result
 
 
