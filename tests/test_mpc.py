@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
-from ground_station.support_mpc import SupportMpc
+from ground_station.support_mpc import CONVERGED, SupportMpc
 from ground_station.work_mpc import predict_work
 from mission.plan_files import read_plan
 
@@ -156,6 +156,64 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting, offset):
     ours = cost(result.path.ravel())
     assert ours == pytest.approx(reference.fun, rel=1e-5)
     assert ours <= reference.fun * (1 + 1e-7)  # IPOPT's optimum is at least as good
+
+
+def test_the_far_branch_is_skipped_only_where_it_cannot_win(setting, monkeypatch):
+    """Far is not solved when near converged below far's floor (w_penalty d_max^2 + w_GNSS U
+    min G); solving it anyway never finds a cheaper plan, so the skip keeps the exact xi."""
+    world, plan, _, mpc = setting
+    control = world.scenario.control
+    g = world.sigma0_map().sigma_m
+    work = predict_work(plan.work[3], 4, plan.work, 5, control.d_max_work_m, control.arrival_tol_m)
+    calls = []
+    solve_branch = mpc._solve_branch
+
+    def spy(solver, fixed, flags, guess, branch):
+        result = solve_branch(solver, fixed, flags, guess, branch)
+        calls.append((branch, (solver, fixed, flags, guess), result))
+        return result
+
+    monkeypatch.setattr(mpc, "_solve_branch", spy)
+    terminal = plan.supports[0][work.indices[5]]
+    away = np.array([1.0, 0.0, 0.0]) * control.d_max_support_m
+    starts = [plan.supports[0][3] + o for o in np.random.default_rng(5).uniform(-2, 2, (6, 3))]
+    starts += [terminal + k * away for k in (4.5, 5.0, 5.5, 5.9)]  # in reach, near stretched
+    for yhat in starts:
+        mpc.solve(yhat, plan.supports[0], work.path, work.indices, g, world.camera.observable)
+    skipped = [
+        (arguments, result)
+        for i, (branch, arguments, result) in enumerate(calls)
+        if branch == "near" and (i + 1 == len(calls) or calls[i + 1][0] != "far")
+    ]
+    assert len(skipped) >= 6  # near wins by far's floor around the waypoint
+    for arguments, near in skipped:
+        far = solve_branch(*arguments, "far")
+        assert far[2] >= near[2] - 1e-9
+
+
+def test_the_far_branch_is_solved_where_it_wins(setting):
+    """A blocked last step anchored 4 m beyond the terminal waypoint: near must end within
+    d_max of the terminal and pays the LOS penalty; far's plan, beyond d_max, is cheaper."""
+    world, plan, _, mpc = setting
+    horizon, d_max = mpc.horizon, world.scenario.control.d_max_support_m
+    yhat = plan.supports[0][3]
+    targets = np.repeat(yhat[None], horizon, axis=0)
+    terminal = yhat + np.array([d_max, 0.0, 0.0])
+    work = np.repeat((yhat + [0.0, 0.0, 3.0])[None], horizon, axis=0)
+    anchors = work.copy()
+    anchors[-1] = terminal + [0.0, 4.0, 0.0]
+    blocked = np.zeros(horizon)
+    blocked[-1] = 1.0
+    corner, window = mpc.window_of(yhat, world.sigma0_map().sigma_m)
+    fixed = np.concatenate([yhat, targets.ravel(), terminal, work.ravel()])
+    flags = np.concatenate([anchors.ravel(), blocked, corner, window])
+    guess = np.linspace(yhat, terminal, horizon + 1)[1:]
+    path, status, cost = mpc._solve_once(mpc._solver, fixed, flags, guess)
+    near = mpc._solve_branch(mpc._solver, fixed, flags, guess, "near")
+    assert status in CONVERGED
+    assert np.linalg.norm(path[-1] - terminal) > d_max
+    assert cost < near[2]
+    assert cost == pytest.approx(mpc.cost(fixed, flags, path))
 
 
 def test_building_the_mpc_leaves_no_files_in_the_working_directory(
