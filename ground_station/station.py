@@ -217,9 +217,9 @@ class GroundStation:
         self._last_seq.clear()  # count losses from here: set-up traffic is not all logged here
         self.link_stats["lost_in"] = 0
         completion = None
-        scn = self.scenario
-        while self.sim_time_s < scn.run.timeout_s - 1e-9:
-            self._advance_clock()
+        tick = self._tick()
+        while tick is not None:
+            self._await_step(tick)
             self._check_links(state)
             measurements = [
                 support_measurement(
@@ -234,7 +234,10 @@ class GroundStation:
             ]
             output = control_cycle(state, measurements, models)
             self._command(state, output)
-            self._record(state, output)
+            cycle_time_s = self.sim_time_s
+            # the next tick goes out now: the vehicles step while this cycle is written down
+            tick = None if state.completed else self._tick()
+            self._record(state, output, cycle_time_s)
             self.cycles += 1
             if self.cycles % SNAPSHOT_EVERY == 0:
                 self._snapshot(models.g, f"{self.cycles:05d}")
@@ -270,39 +273,51 @@ class GroundStation:
     def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
         return build_models(self.world, waypoints, self.config.adaptive, self.config.seed)
 
-    def _advance_clock(self) -> None:
+    def _tick(self) -> Any | None:
+        """Start the next step: in lockstep, advance the clock and send every vehicle the
+        tick (returned, to be sent again if lost); None once the scenario's timeout is reached."""
         step = self.scenario.control.t_cont_s
-        if self.config.speedup is None:
-            target_ms = round((self.sim_time_s + step) * 1000)
-            self.sim_time_s = target_ms / 1000.0
-            tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
-            for view in self.views.values():
+        if self.sim_time_s >= self.scenario.run.timeout_s - 1e-9:
+            return None
+        if self.config.speedup is not None:
+            return step  # real time: the step is waited out in _await_step
+        target_ms = round((self.sim_time_s + step) * 1000)
+        self.sim_time_s = target_ms / 1000.0
+        tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
+        for view in self.views.values():
+            self.send(tick, view)
+        return tick
+
+    def _await_step(self, tick: Any) -> None:
+        """Wait for every vehicle's telemetry of the step ``tick`` started (lockstep), asking
+        again for what was lost; in real time, let the step's wall time pass."""
+        if self.config.speedup is not None:
+            self.pump(tick / self.config.speedup)
+            self.sim_time_s += tick
+            return
+        target_ms = int(tick.time_boot_ms)
+        awaited = [v for v in self.views.values() if not v.lost and not v.late]
+        deadline = time.monotonic() + self.config.step_timeout_wall_s
+        while True:
+            self.pump(
+                min(self.retry_wall_s, max(0.0, deadline - time.monotonic())),
+                lambda: all(v.step_ms >= target_ms for v in awaited),
+            )
+            behind = [v for v in awaited if v.step_ms < target_ms]
+            if not behind or time.monotonic() >= deadline:
+                break
+            for view in behind:  # the tick or the step's telemetry was lost: ask again
                 self.send(tick, view)
-            awaited = [v for v in self.views.values() if not v.lost and not v.late]
-            deadline = time.monotonic() + self.config.step_timeout_wall_s
-            while True:
-                self.pump(
-                    min(self.retry_wall_s, max(0.0, deadline - time.monotonic())),
-                    lambda: all(v.step_ms >= target_ms for v in awaited),
-                )
-                behind = [v for v in awaited if v.step_ms < target_ms]
-                if not behind or time.monotonic() >= deadline:
-                    break
-                for view in behind:  # the tick or the step's telemetry was lost: ask again
-                    self.send(tick, view)
-                    self.link_stats["tick_resends"] += 1
-            stragglers = [v for v in self.views.values() if v.step_ms < target_ms and not v.lost]
-            if stragglers:
-                self.pump(
-                    self.config.late_grace_wall_s,
-                    lambda: all(v.step_ms >= target_ms for v in stragglers),
-                )
-            for view in self.views.values():
-                view.late = view.step_ms < target_ms
-                self.link_stats["late_steps"] += int(view.late and not view.lost)
-        else:
-            self.pump(step / self.config.speedup)
-            self.sim_time_s += step
+                self.link_stats["tick_resends"] += 1
+        stragglers = [v for v in self.views.values() if v.step_ms < target_ms and not v.lost]
+        if stragglers:
+            self.pump(
+                self.config.late_grace_wall_s,
+                lambda: all(v.step_ms >= target_ms for v in stragglers),
+            )
+        for view in self.views.values():
+            view.late = view.step_ms < target_ms
+            self.link_stats["late_steps"] += int(view.late and not view.lost)
 
     def _check_links(self, state: StationState) -> None:
         """Drop a support that fell silent from fusion and the MPCs; take it back when heard."""
@@ -395,10 +410,10 @@ class GroundStation:
         )
         self.tlog.write(self.time_usec, self.endpoint.send(message, []))
 
-    def _record(self, state: StationState, output: CycleOutput) -> None:
+    def _record(self, state: StationState, output: CycleOutput, time_s: float) -> None:
         fusion = output.fusion
         record = {
-            "t": round(self.sim_time_s, 3),
+            "t": round(time_s, 3),
             "k": state.k,
             "xhat": _round(state.xhat),
             "blind": fusion.blind,
