@@ -43,6 +43,15 @@ GUIDED_AND_ARMED = (  # DO_SET_MODE custom mode 4 (GUIDED), then arm
 COMMAND_TIMEOUT_WALL_S = 5.0  # a command is repeated until acknowledged, this long at most
 
 
+@dataclass(frozen=True)
+class PendingStep:
+    """A step the vehicles were asked to make: its length and, in lockstep, the tick that
+    started it (sent again to a vehicle whose telemetry does not arrive)."""
+
+    step_s: float
+    tick: Any | None = None
+
+
 class StationError(RuntimeError):
     """The run cannot go on (a vehicle never appeared, refused its mission, ...)."""
 
@@ -217,9 +226,9 @@ class GroundStation:
         self._last_seq.clear()  # count losses from here: set-up traffic is not all logged here
         self.link_stats["lost_in"] = 0
         completion = None
-        tick = self._tick()
-        while tick is not None:
-            self._await_step(tick)
+        pending = self._tick()
+        while pending is not None:
+            self._await_step(pending)
             self._check_links(state)
             measurements = [
                 support_measurement(
@@ -236,7 +245,7 @@ class GroundStation:
             self._command(state, output)
             cycle_time_s = self.sim_time_s
             # the next tick goes out now: the vehicles step while this cycle is written down
-            tick = None if state.completed else self._tick()
+            pending = None if state.completed else self._tick()
             self._record(state, output, cycle_time_s)
             self.cycles += 1
             if self.cycles % SNAPSHOT_EVERY == 0:
@@ -273,27 +282,28 @@ class GroundStation:
     def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
         return build_models(self.world, waypoints, self.config.adaptive, self.config.seed)
 
-    def _tick(self) -> Any | None:
-        """Start the next step: in lockstep, advance the clock and send every vehicle the
-        tick (returned, to be sent again if lost); None once the scenario's timeout is reached."""
+    def _tick(self) -> PendingStep | None:
+        """Start the next step (None once the scenario's timeout is reached): in lockstep,
+        advance the clock and send every vehicle the tick; in real time the step just runs."""
         step = self.scenario.control.t_cont_s
         if self.sim_time_s >= self.scenario.run.timeout_s - 1e-9:
             return None
         if self.config.speedup is not None:
-            return step  # real time: the step is waited out in _await_step
+            return PendingStep(step)
         target_ms = round((self.sim_time_s + step) * 1000)
         self.sim_time_s = target_ms / 1000.0
         tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
         for view in self.views.values():
             self.send(tick, view)
-        return tick
+        return PendingStep(step, tick)
 
-    def _await_step(self, tick: Any) -> None:
-        """Wait for every vehicle's telemetry of the step ``tick`` started (lockstep), asking
-        again for what was lost; in real time, let the step's wall time pass."""
-        if self.config.speedup is not None:
-            self.pump(tick / self.config.speedup)
-            self.sim_time_s += tick
+    def _await_step(self, pending: PendingStep) -> None:
+        """Lockstep: wait for every vehicle's telemetry of the step, sending the tick again to
+        a vehicle that stays behind. Real time: let the step's wall time pass."""
+        tick = pending.tick
+        if tick is None:
+            self.pump(pending.step_s / self.config.speedup)
+            self.sim_time_s += pending.step_s
             return
         target_ms = int(tick.time_boot_ms)
         awaited = [v for v in self.views.values() if not v.lost and not v.late]

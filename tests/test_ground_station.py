@@ -114,6 +114,19 @@ def test_a_short_mission_completes_and_is_logged(short_scenario, tmp_path):
     ):
         assert counts.get(kind, 0) > 0, kind
     assert counts["SET_POSITION_TARGET_LOCAL_NED"] == 4 * summary["control_cycles"]
+    # a record per cycle at the cycle's time, though the next tick goes out before it is written
+    t_cont = load_scenario(str(short_scenario)).control.t_cont_s
+    assert [r["t"] for r in records] == [
+        round(t_cont * (i + 1), 3) for i in range(summary["control_cycles"])
+    ]
+    assert records[-1]["t"] == summary["completion_time_s"]
+    # one tick a vehicle a cycle (and the resends): none after the mission completed
+    log = mavutil.mavlink_connection(str(tmp_path / "gcs.tlog"), dialect="ardupilotmega")
+    ticks = 0
+    while (message := log.recv_match(type="SYSTEM_TIME")) is not None:
+        ticks += message.get_srcSystem() == 255
+    resends = json.loads((tmp_path / "link.json").read_text())["tick_resends"]
+    assert ticks == 4 * summary["control_cycles"] + resends
 
 
 def test_mavlogdump_reads_the_tlog_and_nac_leaves_g(short_scenario, tmp_path):
