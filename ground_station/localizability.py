@@ -101,25 +101,31 @@ def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) 
     return result
 
 
-def casadi_smoothed(grid: VoxelGrid) -> ca.Function:
-    """G_s(x (3), values (nx*ny*nz, first axis fastest)) as a casadi Function."""
-    axes = [list(np.arange(n, dtype=float)) for n in grid.shape]
-    table = ca.interpolant("G", "linear", axes, 1)
-    x = ca.MX.sym("x", 3)
-    values = ca.MX.sym("values", grid.n_voxels)
-    upper = np.array(grid.shape, dtype=float) - 1
-    u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
-    warped = ca.vertcat(*(warped_index(u[a], upper[a]) for a in range(3)))
-    return ca.Function("G_s", [x, values], [table(warped, values)])
+def casadi_hermite(grid: VoxelGrid, x: ca.MX, values: ca.MX) -> ca.MX:
+    """G_s at x (3) for voxel values (nx*ny*nz, first axis fastest), as a casadi expression.
 
-
-def casadi_smoothed_constant(grid: VoxelGrid, values: np.ndarray) -> ca.Function:
-    """The same zero-slope Hermite field for fixed values (e.g. sigma_0): x (3) -> value."""
-    axes = [list(np.arange(n, dtype=float)) for n in grid.shape]
-    data = np.asarray(values, dtype=float).reshape(grid.shape).ravel(order="F")
-    table = ca.interpolant("sigma0", "linear", axes, data)
-    x = ca.MX.sym("x", 3)
-    upper = np.array(grid.shape, dtype=float) - 1
+    The eight corner values are gathered by index and weighted as in
+    :func:`hermite_zero_slope`, so every derivative is exact. casadi's parametric linear
+    interpolant computes the same values, but its second derivatives lack the mixed terms
+    (d2/dx dy = 0, which cost IPOPT extra iterations and some failures), and its derivatives,
+    like those of any Function call, carry a dense seed for every value. Written inline, the
+    derivatives touch the eight gathered values only.
+    """
+    shape = np.array(grid.shape)
     u = (x - ca.DM(grid.origin_m)) / grid.voxel_m - 0.5
-    warped = ca.vertcat(*(warped_index(u[a], upper[a]) for a in range(3)))
-    return ca.Function("sigma0_s", [x], [table(warped)])
+    bases, fracs = [], []
+    for a in range(3):
+        warped = warped_index(u[a], float(shape[a] - 1))
+        base = ca.fmin(ca.floor(warped), float(max(shape[a] - 2, 0)))
+        bases.append(base)
+        fracs.append(warped - base)
+    strides = np.concatenate([[1], np.cumprod(shape[:-1])]).astype(float)
+    total = 0
+    for corner in _CORNERS:  # summed in corner order with weights f0 f1 f2, as in numpy
+        index = 0
+        weight = 1
+        for a in range(3):
+            index += strides[a] * ca.fmin(bases[a] + float(corner[a]), float(shape[a] - 1))
+            weight *= fracs[a] if corner[a] else 1 - fracs[a]
+        total += weight * values[index]
+    return total

@@ -39,11 +39,8 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from ground_station.localizability import (
-    casadi_smoothed,
-    casadi_smoothed_constant,
-    hermite_zero_slope,
-)
+from ground_station.casadi_buffer import BufferedFunction
+from ground_station.localizability import casadi_hermite, hermite_zero_slope
 from mission.camera import CameraModel
 from mission.grid import VoxelGrid
 from mission.settings import ControlSettings
@@ -52,11 +49,15 @@ IPOPT_OPTIONS = {
     "ipopt.print_level": 0,
     "ipopt.sb": "yes",
     "print_time": False,
+    "calc_lam_p": False,  # unused; its gradient over the G window costs more than the solve
     "ipopt.max_iter": 50,
     "ipopt.tol": 1e-4,  # positions to ~0.1 mm; 1e-6 cost 25 % more iterations for nothing
     "ipopt.acceptable_tol": 1e-4,
     "ipopt.warm_start_init_point": "yes",
     "ipopt.hessian_approximation": "exact",  # measured: 3x fewer ms than L-BFGS here
+    # MUMPS's matching-based permutation and scaling are for hard large systems; here they
+    # cost 5 % of a solve and change the solutions by 1e-14 (600 recorded problems)
+    "ipopt.mumps_permuting_scaling": 0,
 }
 COMPILE_FLAGS = ["-O2", "-fPIC", "-shared"]
 ESCAPE_STARTS = 1  # escape starts solved: the cheapest of six where it starts
@@ -121,9 +122,10 @@ class SupportPlan:
 class SupportMpc:
     """One NLP, built once, solved for any support with its own parameters.
 
-    G enters through a cube of voxels around yhat_n, wide enough for everything the horizon
-    can reach (U d_max plus a margin on each side), so a solve passes a few thousand values
-    rather than the whole map; the cube's corner is a parameter.
+    G (and sigma_0, for the shadow constraint) enter through a cube of voxels around yhat_n,
+    wide enough for everything the horizon can reach (U d_max plus a margin on each side), so
+    a solve passes a few thousand values rather than the whole map; the cube's corner is a
+    parameter.
     """
 
     def __init__(
@@ -147,7 +149,7 @@ class SupportMpc:
         self._build_dir = tempfile.TemporaryDirectory(
             prefix="support-mpc-", ignore_cleanup_errors=True
         )
-        self._solver = self._build()
+        self._solver, self._cost = self._build()
         cube = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=3)))
         cube = cube[np.any(cube != 0, axis=1)]
         self._directions = cube / np.linalg.norm(cube, axis=1, keepdims=True)
@@ -162,13 +164,11 @@ class SupportMpc:
             "far": np.concatenate([steps, [np.inf], shadow]),
         }
 
-    def _build(self) -> ca.Function:
-        """The NLP's IPOPT solver, its functions compiled when a C compiler is there."""
+    def _build(self) -> tuple[BufferedFunction, BufferedFunction]:
+        """The NLP's IPOPT solver (its functions compiled when a C compiler is there) and its
+        cost function."""
         c, horizon = self.control, self.horizon
         sym = ca.MX
-        g_s = casadi_smoothed(self._window_grid)
-        if self.sigma0 is not None:
-            prior_sigma = casadi_smoothed_constant(self.grid, self.sigma0)
         v = sym.sym("v", 3, horizon)
         yhat = sym.sym("yhat", 3)
         targets = sym.sym("w", 3, horizon)
@@ -177,6 +177,7 @@ class SupportMpc:
         anchors = sym.sym("q", 3, horizon)  # where a blocked step is pulled (see _anchors)
         blocked = sym.sym("blocked", horizon)
         values = sym.sym("G", self._window_grid.n_voxels)
+        prior = sym.sym("sigma0", 0 if self.sigma0 is None else self._window_grid.n_voxels)
         corner = sym.sym("corner", 3)
 
         terminal_weight = sym.sym("w_terminal")  # xi's weight on the branch being solved
@@ -188,7 +189,7 @@ class SupportMpc:
         # so keeps the cost smooth. The terminal link is solved per branch (module docstring).
         cost = c.w_interval * sq(yhat - v[:, 0])
         for u in range(horizon):
-            cost += c.w_gnss * g_s(v[:, u] - corner, values)
+            cost += c.w_gnss * casadi_hermite(self._window_grid, v[:, u] - corner, values)
             cost += c.w_waypoint * sq(v[:, u] - targets[:, u])
             cost += (1 - blocked[u]) * c.w_relative * sq(work[:, u] - v[:, u])
             cost += blocked[u] * c.w_penalty * sq(anchors[:, u] - v[:, u])
@@ -206,6 +207,7 @@ class SupportMpc:
             blocked,
             corner,
             values,
+            prior,
         )
         # The vehicle cannot fly faster than s_max: each predicted step is also bounded hard
         # (the paper's penalty alone lets a discontinuous cost trap IPOPT beyond d_max).
@@ -213,27 +215,41 @@ class SupportMpc:
         # Stay where the prior map (structure and sky, no zones) predicts a usable fix: the
         # paper's LOS penalty pulls a blocked support straight at the work UAV, i.e. under the
         # deck, where it would lose its fix (and fly into the structure).
-        shadow = [] if self.sigma0 is None else [prior_sigma(v[:, u]) for u in range(horizon)]
-        self._cost = ca.Function("support_mpc_cost", [ca.vec(v), parameters], [cost])
+        shadow = (
+            []
+            if self.sigma0 is None
+            else [
+                casadi_hermite(self._window_grid, v[:, u] - corner, prior) for u in range(horizon)
+            ]
+        )
+        cost_function = ca.Function(
+            "support_mpc_cost", [ca.vec(v), parameters], [cost], ["x", "p"], ["f"]
+        )
         constraints = ca.vertcat(*steps, terminal_sq, *shadow)
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": constraints}
-        interpreted = ca.nlpsol("support_mpc", "ipopt", nlp, IPOPT_OPTIONS)
-        library = compiled_nlp(interpreted, self._build_dir.name)
-        if library is None:
-            return interpreted
-        return ca.nlpsol("support_mpc", "ipopt", library, IPOPT_OPTIONS)
+        solver = ca.nlpsol("support_mpc", "ipopt", nlp, IPOPT_OPTIONS)
+        library = compiled_nlp(solver, self._build_dir.name)
+        if library is not None:
+            solver = ca.nlpsol("support_mpc", "ipopt", library, IPOPT_OPTIONS)
+        unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
+        return (
+            BufferedFunction(solver, ("x", "f"), unbounded),
+            BufferedFunction(cost_function, ("f",)),
+        )
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(corner of the window in world coordinates, its values first-axis-fastest)."""
+        """(corner of the window in world coordinates, the values the NLP takes there: G's
+        and then sigma_0's, each first-axis-fastest)."""
         shape = np.array(self.grid.shape)
         size = np.array(self.window)
         centre = self.grid.index_of(np.asarray(yhat)[None])[0]
         low = np.clip(centre - size // 2, 0, shape - size)
-        block = g_values[
-            low[0] : low[0] + size[0], low[1] : low[1] + size[1], low[2] : low[2] + size[2]
-        ]
+        cube = tuple(slice(low[a], low[a] + size[a]) for a in range(3))
         corner = self.grid.origin_m + self.grid.voxel_m * low
-        return corner, block.ravel(order="F")
+        maps = [np.asarray(g_values).reshape(self.grid.shape)[cube].ravel(order="F")]
+        if self.sigma0 is not None:
+            maps.append(self.sigma0[cube].ravel(order="F"))
+        return corner, np.concatenate(maps)
 
     def solve(
         self,
@@ -292,8 +308,9 @@ class SupportMpc:
         best = None
         if np.linalg.norm(terminal - yhat) <= reach:
             best = self._solve_branch(solver, fixed, flags, guess, "near")
-            window = flags[3 * horizon + horizon + 3 :]
-            far_floor = c.w_penalty * c.d_max_support_m**2 + c.w_gnss * horizon * window.min()
+            start = 3 * horizon + horizon + 3  # G's window, after the anchors, flags, corner
+            g_min = flags[start : start + self._window_grid.n_voxels].min()
+            far_floor = c.w_penalty * c.d_max_support_m**2 + c.w_gnss * horizon * g_min
             if best[1] in CONVERGED and best[2] <= far_floor:
                 return best
         far = self._solve_branch(solver, fixed, flags, guess, "far")
@@ -307,13 +324,12 @@ class SupportMpc:
         result = solver(
             x0=guess.ravel(),
             p=np.concatenate([fixed, [weight], flags]),
-            lbg=-np.inf,
             ubg=self._upper_bounds[branch],
         )
         status = solver.stats()["return_status"]
-        path = np.array(result["x"]).reshape(self.horizon, 3)
+        path = result["x"].reshape(self.horizon, 3)
         terminal_sq = float(np.sum((self._terminal_of(fixed) - path[-1]) ** 2))
-        cost = float(result["f"]) + (self._xi_weight(terminal_sq) - weight) * terminal_sq
+        cost = float(result["f"][0]) + (self._xi_weight(terminal_sq) - weight) * terminal_sq
         return path, status, cost
 
     def _terminal_of(self, fixed: np.ndarray) -> np.ndarray:
@@ -375,7 +391,7 @@ class SupportMpc:
         """The true cost of ``path`` (terminal xi on its side of d_max)."""
         terminal_sq = float(np.sum((self._terminal_of(fixed) - path[-1]) ** 2))
         weight = self._xi_weight(terminal_sq)
-        return float(self._cost(path.ravel(), np.concatenate([fixed, [weight], flags])))
+        return float(self._cost(x=path.ravel(), p=np.concatenate([fixed, [weight], flags]))["f"][0])
 
 
 def support_cost_numpy(

@@ -1,0 +1,51 @@
+"""Calling a casadi Function from numpy without converting its arguments each call.
+
+``Function.__call__`` turns every numpy argument into a casadi DM, about 60 ns per value: for
+the support MPC's ~4,500 parameters that is ~0.2 ms a call, as much as several IPOPT
+iterations. casadi's FunctionBuffer instead reads and writes fixed numpy arrays in place.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+
+class BufferedFunction:
+    """A casadi Function evaluated on arrays it owns: inputs are copied in, outputs copied out.
+
+    Inputs not given to a call keep their last value; ``defaults`` sets their first one
+    (otherwise zeros). Only the ``outputs`` named are computed.
+    """
+
+    def __init__(
+        self,
+        function: ca.Function,
+        outputs: tuple[str, ...],
+        defaults: dict[str, float] | None = None,
+    ) -> None:
+        self.function = function
+        self._buffer, self._evaluate = function.buffer()
+        defaults = defaults or {}
+        self._inputs: dict[str, np.ndarray] = {}
+        for index, name in enumerate(function.name_in()):
+            array = np.full(function.nnz_in(index), defaults.get(name, 0.0))
+            self._buffer.set_arg(index, memoryview(array))
+            self._inputs[name] = array  # the buffer keeps a pointer: the array must live
+        self._outputs: dict[str, np.ndarray] = {}
+        for name in outputs:
+            index = function.index_out(name)
+            array = np.zeros(function.nnz_out(index))
+            self._buffer.set_res(index, memoryview(array))
+            self._outputs[name] = array
+
+    def __call__(self, **inputs: np.ndarray | float) -> dict[str, np.ndarray]:
+        """Evaluate with these inputs (by name); the named outputs, as fresh arrays."""
+        for name, value in inputs.items():
+            self._inputs[name][:] = value
+        self._evaluate()
+        return {name: array.copy() for name, array in self._outputs.items()}
+
+    def stats(self) -> dict:
+        """The statistics of the last evaluation (for a solver: return_status, iter_count)."""
+        return self._buffer.stats()
