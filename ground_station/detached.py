@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ground_station.cycle import CycleOutput, control_cycle
-from ground_station.measurements import measurement_from_values
+from ground_station.measurements import MeasuredValues, measurements_from_values
 from ground_station.station import build_models
 from mission.world import World
 from vehicle_sim.kinematics import Kinematics
@@ -47,16 +47,17 @@ def run_detached(
     outputs, truth = [], []
     for _ in range(max_cycles):
         work_truth = vehicles["work"].truth
-        measurements = []
+        values = []
         for name in models.support_waypoints:
             y = vehicles[name].truth
             fix = world.gnss.sample_fix(y, rng, world.zone_offset(y[None])[0])
             observation = world.camera.observe(y, work_truth, rng)
-            measurements.append(
-                measurement_from_values(
-                    name, fix.position_m if fix.has_fix else None, observation.relative_m, world
+            values.append(
+                MeasuredValues(
+                    name, fix.position_m if fix.has_fix else None, observation.relative_m
                 )
             )
+        measurements = measurements_from_values(values, world)
         output = control_cycle(state, measurements, models)
         outputs.append(output)
         truth.append(work_truth.copy())

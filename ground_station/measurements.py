@@ -5,6 +5,8 @@ Only these two messages feed the estimator. SIM_STATE (truth) is logged, never r
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -32,35 +34,52 @@ def relative_observation(message: Any | None) -> np.ndarray | None:
     return r if np.all(np.isfinite(r)) and np.linalg.norm(r) > 0 else None
 
 
-def support_measurement(
-    name: str, gps: Any | None, target: Any | None, world: World, frame: GeodeticFrame
-) -> SupportMeasurement:
-    """p_n, r_n and their covariances from the step's GPS_RAW_INT and LANDING_TARGET."""
-    fix = gnss_fix(gps, frame)
-    reported = None
-    if fix is not None:
-        h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
-        reported = np.diag([h * h / 2, h * h / 2, v * v])
-    return measurement_from_values(name, fix, relative_observation(target), world, reported)
+def support_measurements(
+    messages: Sequence[tuple[str, Any | None, Any | None]], world: World, frame: GeodeticFrame
+) -> list[SupportMeasurement]:
+    """p_n, r_n and their covariances from each support's (name, GPS_RAW_INT, LANDING_TARGET)
+    of the step."""
+    values = []
+    for name, gps, target in messages:
+        fix = gnss_fix(gps, frame)
+        reported = None
+        if fix is not None:
+            h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
+            reported = np.diag([h * h / 2, h * h / 2, v * v])
+        values.append(MeasuredValues(name, fix, relative_observation(target), reported))
+    return measurements_from_values(values, world)
 
 
-def measurement_from_values(
-    name: str,
-    fix: np.ndarray | None,
-    relative: np.ndarray | None,
-    world: World,
-    reported: np.ndarray | None = None,
-) -> SupportMeasurement:
-    """Covariances evaluated at the measured values (MODEL.md 3.2.1).
+@dataclass(frozen=True)
+class MeasuredValues:
+    """One support's measured p_n and r_n (None where missing) and the receiver's reported
+    covariance."""
+
+    name: str
+    fix: np.ndarray | None
+    relative: np.ndarray | None
+    reported: np.ndarray | None = None
+
+
+def measurements_from_values(
+    values: Sequence[MeasuredValues], world: World
+) -> list[SupportMeasurement]:
+    """Covariances evaluated at the measured values (MODEL.md 3.2.1), the GNSS geometry of
+    every fix in one batch (the same numbers as one at a time).
 
     Where the model sees no fix at p_n but the receiver has one, the receiver's reported
     accuracy stands in for Sigma_GNSS.
     """
-    sigma_gnss = None
-    if fix is not None:
-        has_fix, sigma = world.gnss.sigma_gnss(fix[None])
-        sigma_gnss = sigma[0] if has_fix[0] else reported
-        if sigma_gnss is None:
-            fix = None
-    sigma_relative = world.camera.covariance(relative) if relative is not None else None
-    return SupportMeasurement(name, fix, sigma_gnss, relative, sigma_relative)
+    with_fix = [v for v in values if v.fix is not None]
+    sigma_of: dict[str, np.ndarray | None] = {}
+    if with_fix:
+        has_fix, sigma = world.gnss.sigma_gnss(np.array([v.fix for v in with_fix]))
+        for i, v in enumerate(with_fix):
+            sigma_of[v.name] = sigma[i] if has_fix[i] else v.reported
+    measurements = []
+    for v in values:
+        sigma_gnss = sigma_of.get(v.name)
+        fix = v.fix if sigma_gnss is not None else None
+        sigma_relative = world.camera.covariance(v.relative) if v.relative is not None else None
+        measurements.append(SupportMeasurement(v.name, fix, sigma_gnss, v.relative, sigma_relative))
+    return measurements

@@ -20,7 +20,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from ground_station.cycle import CycleOutput, Models, StationState, control_cycle
 from ground_station.localizability import LocalizabilityMap
-from ground_station.measurements import support_measurement
+from ground_station.measurements import support_measurements
 from ground_station.mission_client import MissionClient, MissionTransferError
 from ground_station.support_mpc import SupportMpc
 from ground_station.tlog import TlogWriter
@@ -230,17 +230,19 @@ class GroundStation:
         while pending is not None:
             self._await_step(pending)
             self._check_links(state)
-            measurements = [
-                support_measurement(
-                    name,
-                    self._current(name, "GPS_RAW_INT"),
-                    self._current(name, "LANDING_TARGET"),
-                    self.world,
-                    self.frame,
-                )
-                for name in supports
-                if not self.views[name].lost
-            ]
+            measurements = support_measurements(
+                [
+                    (
+                        name,
+                        self._current(name, "GPS_RAW_INT"),
+                        self._current(name, "LANDING_TARGET"),
+                    )
+                    for name in supports
+                    if not self.views[name].lost
+                ],
+                self.world,
+                self.frame,
+            )
             output = control_cycle(state, measurements, models)
             self._command(state, output)
             cycle_time_s = self.sim_time_s

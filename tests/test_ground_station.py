@@ -166,7 +166,7 @@ def test_real_time_mode_completes_too(short_scenario, tmp_path):
 def test_sim_state_never_reaches_the_estimator(along, tmp_path):
     """Same measurements, wildly different SIM_STATE: identical commands and estimates."""
     from ground_station.cycle import control_cycle
-    from ground_station.measurements import support_measurement
+    from ground_station.measurements import support_measurements
     from ground_station.station import GroundStation, StationConfig
     from mission.frames import GeodeticFrame
     from mission.mavlink_udp import MavlinkCodec
@@ -202,16 +202,18 @@ def test_sim_state_never_reaches_the_estimator(along, tmp_path):
             ):
                 decoded = codec.decode(codec.encode(message))[0][0]
                 station._log_received(decoded, ("127.0.0.1", 9))
-        measurements = [
-            support_measurement(
-                name,
-                station._current(name, "GPS_RAW_INT"),
-                station._current(name, "LANDING_TARGET"),
-                world,
-                frame,
-            )
-            for name in ("support-1", "support-2", "support-3")
-        ]
+        measurements = support_measurements(
+            [
+                (
+                    name,
+                    station._current(name, "GPS_RAW_INT"),
+                    station._current(name, "LANDING_TARGET"),
+                )
+                for name in ("support-1", "support-2", "support-3")
+            ],
+            world,
+            frame,
+        )
         assert all(m.contributes for m in measurements)
         assert station.views["support-1"].latest["SIM_STATE"].get_type() == "SIM_STATE"
         output = control_cycle(state, measurements, models)

@@ -70,3 +70,21 @@ def client_heartbeat():
     return mavlink2.MAVLink_heartbeat_message(
         mavlink2.MAV_TYPE_GCS, mavlink2.MAV_AUTOPILOT_INVALID, 0, 0, 0, 3
     )
+
+
+def test_a_waiting_vehicle_answers_a_new_peer_at_once():
+    """Before the first tick a vehicle beats once a second; a new ground station does not wait
+    for the next beat (the first client's beat fixes the phase: the next is ~1 s away)."""
+    with vehicle_process("support-1") as vehicle:
+        first = MavClient(vehicle.address)
+        first.send(client_heartbeat())
+        assert first.wait_for("HEARTBEAT", 3.0) is not None
+        second = MavClient(vehicle.address, system_id=254)
+        sent = time.monotonic()
+        second.send(client_heartbeat())
+        answer = second.wait_for("HEARTBEAT", 3.0)
+        waited = time.monotonic() - sent
+        first.close()
+        second.close()
+    assert answer is not None
+    assert waited < 0.3

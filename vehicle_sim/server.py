@@ -157,6 +157,8 @@ class VehicleServer:
         assert vehicle is not None
         if message.get_srcSystem() == vehicle.identity.system_id:
             return  # our own echo (e.g. through a mirror)
+        if sender not in self.peers:
+            self._last_idle_heartbeat = -math.inf  # a new peer hears from us at once
         self.peers[sender] = now
         if message.get_type() == "SYSTEM_TIME":
             if self.clock.lockstep:
