@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import argparse
 import json
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -76,6 +78,13 @@ def build_parser() -> OneLineArgumentParser:
         metavar="FILE",
         help="MAVLink 2 signing: 32-byte secret (raw or 64 hex digits)",
     )
+    parser.add_argument(
+        "--mpc-helper",
+        action=argparse.BooleanOptionalAction,
+        default=(os.cpu_count() or 1) >= 2,
+        help="share the support MPCs with a helper process on a second core "
+        "(default: on with two or more cores; same plans either way)",
+    )
     return parser
 
 
@@ -91,6 +100,7 @@ def read_waypoints_file(path: Path) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a mission and print its summary as JSON."""
     from ground_station.station import GroundStation, StationConfig, StationError
+    from ground_station.support_planning import HelperError
 
     args = build_parser().parse_args(argv)
     if args.exit_with_parent:
@@ -116,13 +126,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         tlog_path=args.tlog,
         signing_key=read_signing_key(args.signing_key) if args.signing_key else None,
         link=link_settings(args),
+        mpc_helper=args.mpc_helper,
     )
     station = GroundStation(world, config)
     host, port = station.endpoint.address
     print(f"ground station listening on {host}:{port}", file=sys.stderr, flush=True)
     try:
         summary = station.run()
-    except StationError as error:
+    except (StationError, HelperError) as error:
         print(f"ground station: {error}", file=sys.stderr)
         return 1
     finally:

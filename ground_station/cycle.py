@@ -21,7 +21,8 @@ from ground_station.fusion import (
     support_feedback,
 )
 from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
-from ground_station.support_mpc import SupportMpc, SupportPlan
+from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
+from ground_station.support_planning import LocalPlanner
 from ground_station.work_mpc import WorkPrediction, predict_work
 from mission.settings import Scenario
 from mission.world import World
@@ -40,6 +41,7 @@ class Models:
     g: LocalizabilityMap
     support_mpc: SupportMpc
     rng: np.random.Generator
+    planner: LocalPlanner  # solves the support MPCs: here, or shared with a helper process
 
 
 @dataclass
@@ -92,10 +94,9 @@ def control_cycle(
         control.d_max_work_m,
         control.arrival_tol_m,
     )
-    # One after another: IPOPT's bookkeeping holds the GIL for much of a solve, and neither a
-    # thread nor a process per support shortened a run (measured), while both cost 15-25 %
-    # more CPU, which is what a batch of runs is bound by.
-    plans = {s.name: plan_support(state, s.name, work, models) for s in supports}
+    plans = models.planner.plan_all(
+        [support_request(state, s.name, work, models) for s in supports]
+    )
     state.last_work_command = _reachable(
         state.xhat, work.command, control.s_max_work_m_s * control.t_cont_s
     )
@@ -145,20 +146,21 @@ def check_arrival(state: StationState, waypoints: np.ndarray, tolerance_m: float
     return reached
 
 
-def plan_support(
+def support_request(
     state: StationState, name: str, work: WorkPrediction, models: Models
-) -> SupportPlan:
-    """The support MPC for one support; escape starts where G says GNSS is worse than expected."""
+) -> PlanRequest:
+    """The support MPC's problem for one support; escape starts where G says GNSS is worse
+    than expected."""
     yhat = state.yhat[name]
     g = models.g
     escape = bool(g.smoothed(yhat)[0] > _initial_smoothed(g, yhat) + ESCAPE_MARGIN_M)
-    return models.support_mpc.solve(
+    return models.support_mpc.request(
+        name,
         yhat,
         models.support_waypoints[name],
         work.path,
         work.indices,
         g.values,
-        models.world.camera.observable,
         state.warm.get(name),
         escape=escape,
     )

@@ -23,6 +23,7 @@ from ground_station.localizability import LocalizabilityMap
 from ground_station.measurements import support_measurements
 from ground_station.mission_client import MissionClient, MissionTransferError
 from ground_station.support_mpc import SupportMpc
+from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
 from ground_station.tlog import TlogWriter
 from mission.atomic import write_text_atomically
 from mission.frames import GeodeticFrame, enu_to_ned
@@ -73,6 +74,7 @@ class StationConfig:
     late_grace_wall_s: float = 0.05  # lockstep: how long a late vehicle is waited for
     link_loss_s: float = 3.0  # simulated seconds of silence before a vehicle counts as lost
     connect_timeout_wall_s: float = 30.0
+    mpc_helper: bool = False  # share the support MPCs with a helper process (second core)
 
 
 @dataclass
@@ -120,6 +122,8 @@ class GroundStation:
         self.by_system = {v.system_id: v for v in self.views.values()}
         self.sim_time_s = 0.0
         self.cycles = 0
+        self.models: Models | None = None
+        self._helper: MpcHelper | None = None
 
     # -- links ------------------------------------------------------------------------------
     @property
@@ -217,6 +221,8 @@ class GroundStation:
     def run(self) -> dict[str, Any]:
         """Connect, upload, arm, then cycle until done or timeout; return a summary."""
         start_wall = time.monotonic()
+        if self.config.mpc_helper:  # it builds its solver while we connect
+            self._helper = MpcHelper(self.scenario)
         self.connect()
         waypoints = self.upload_missions()
         self.arm_all()
@@ -282,7 +288,10 @@ class GroundStation:
         write_text_atomically(self.config.out_dir / "link.json", json.dumps(stats) + "\n")
 
     def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
-        return build_models(self.world, waypoints, self.config.adaptive, self.config.seed)
+        self.models, state = build_models(
+            self.world, waypoints, self.config.adaptive, self.config.seed, self._helper
+        )
+        return self.models, state
 
     def _tick(self) -> PendingStep | None:
         """Start the next step (None once the scenario's timeout is reached): in lockstep,
@@ -449,7 +458,11 @@ class GroundStation:
         np.save(self.snapshots / f"G_{label}.npy", g.values)
 
     def close(self) -> None:
-        """Flush and close every file and the socket."""
+        """Stop the MPC helper; flush and close every file and the socket."""
+        if self.models is not None:
+            self.models.planner.close()
+        elif self._helper is not None:
+            self._helper.close()
         self.tlog.close()
         self.records.close()
         self.endpoint.close()
@@ -465,21 +478,29 @@ def _round(v: np.ndarray) -> list[float]:
 
 
 def build_models(
-    world: World, waypoints: dict[str, np.ndarray], adaptive: bool, seed: int
+    world: World,
+    waypoints: dict[str, np.ndarray],
+    adaptive: bool,
+    seed: int,
+    helper: MpcHelper | None = None,
 ) -> tuple[Models, StationState]:
-    """Everything the control cycle needs, and the state at the start (vehicles at w_1)."""
+    """Everything the control cycle needs, and the state at the start (vehicles at w_1);
+    the support MPCs are shared with ``helper`` if one is given."""
     scn = world.scenario
     grid = world.map_grid()
     g = LocalizabilityMap(grid, world.sigma0_map().sigma_m, scn.map, adaptive)
     supports = {n: w for n, w in waypoints.items() if n != "work"}
+    mpc = SupportMpc(scn.control, grid, world.camera, g.initial)
+    observable = world.camera.observable
     models = Models(
         scn,
         world,
         waypoints["work"],
         supports,
         g,
-        SupportMpc(scn.control, grid, world.camera, g.initial),
+        mpc,
         np.random.default_rng(seed),
+        LocalPlanner(mpc, observable) if helper is None else HelperPlanner(mpc, observable, helper),
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),

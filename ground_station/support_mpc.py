@@ -103,6 +103,22 @@ def _cache_dir() -> Path:
 
 
 @dataclass(frozen=True)
+class PlanRequest:
+    """One support's MPC problem: its estimate, the waypoints its horizon aims at, the work
+    UAV's predicted path, the map window (corner; G's and sigma_0's values), the warm start."""
+
+    name: str
+    yhat: np.ndarray
+    targets: np.ndarray  # (U, 3): w_{n,k_u}
+    terminal: np.ndarray  # w_{n,k_{U+1}}
+    work: np.ndarray  # (U, 3): the work UAV's predicted path
+    corner: np.ndarray
+    window: np.ndarray
+    warm_start: np.ndarray | None
+    escape: bool
+
+
+@dataclass(frozen=True)
 class SupportPlan:
     """The optimised local path V_n (U, 3) and how the solve went."""
 
@@ -264,20 +280,58 @@ class SupportMpc:
     ) -> SupportPlan:
         """Optimise V_n (``g_values``: G as a 3-D array; ``observable(a, b)``: rows of b
         observable from rows of a)."""
-        solver = self._solver
+        return self.plan(
+            self.request(
+                "", yhat, support_waypoints, work_path, work_indices, g_values, warm_start, escape
+            ),
+            observable,
+        )
+
+    def request(
+        self,
+        name: str,
+        yhat: np.ndarray,
+        support_waypoints: np.ndarray,
+        work_path: np.ndarray,
+        work_indices: np.ndarray,
+        g_values: np.ndarray,
+        warm_start: np.ndarray | None = None,
+        escape: bool = False,
+    ) -> PlanRequest:
+        """Everything one support's solve needs, G cut down to the window around yhat."""
         horizon = self.horizon
-        targets = support_waypoints[work_indices[:horizon]]
-        terminal = support_waypoints[work_indices[horizon]]
-        work = work_path[:horizon]
         corner, window = self.window_of(yhat, g_values)
+        return PlanRequest(
+            name,
+            np.asarray(yhat, dtype=float),
+            support_waypoints[work_indices[:horizon]],
+            support_waypoints[work_indices[horizon]],
+            work_path[:horizon],
+            corner,
+            window,
+            warm_start,
+            escape,
+        )
+
+    def plan(self, request: PlanRequest, observable) -> SupportPlan:
+        """Optimise V_n for one request (``observable(a, b)``: rows of b observable from rows
+        of a)."""
+        solver = self._solver
+        yhat, targets, terminal, work = (
+            request.yhat,
+            request.targets,
+            request.terminal,
+            request.work,
+        )
+        corner, window = request.corner, request.window
         fixed = np.concatenate([yhat, targets.ravel(), terminal, work.ravel()])
-        guess = self._initial_guess(yhat, terminal, warm_start)
+        guess = self._initial_guess(yhat, terminal, request.warm_start)
         start = time.perf_counter()
         blocked = ~observable(guess, work)
         anchors = self.anchors(guess, work, targets, blocked)
         flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window])
         path, status, cost = self._solve_once(solver, fixed, flags, guess)
-        if escape:  # G_s is flat at voxel centres: also start from paths leaving each way
+        if request.escape:  # G_s is flat at voxel centres: also start from paths leaving each way
             for candidate in self._escape_guesses(yhat, fixed, flags):
                 tried = self._solve_once(solver, fixed, flags, candidate)
                 if tried[2] < cost - 1e-9:

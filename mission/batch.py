@@ -9,6 +9,7 @@ skips what is done and an interrupted batch loses nothing. ``results.csv``, ``ta
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import subprocess
@@ -108,12 +109,13 @@ def _run_pool(
     """Keep ``jobs`` runs going; on any exit (Ctrl-C included) stop the ones still running."""
     queue = list(pending)
     running: dict[Trial, subprocess.Popen] = {}
+    mpc_helper = helper_has_a_core(jobs, os.cpu_count() or 1)
     previous = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         while queue or running:
             while queue and len(running) < jobs:
                 trial = queue.pop(0)
-                running[trial] = _start_run(trial, runs_dir / trial.key)
+                running[trial] = _start_run(trial, runs_dir / trial.key, mpc_helper)
             for trial, process in list(running.items()):
                 if process.poll() is not None:
                     del running[trial]
@@ -131,11 +133,17 @@ def _run_pool(
                 process.wait()
 
 
+def helper_has_a_core(jobs: int, cores: int) -> bool:
+    """Whether each of ``jobs`` parallel runs can give its ground station's MPC helper a core
+    of its own (otherwise the helper only adds round trips)."""
+    return 2 * jobs <= cores
+
+
 def _raise_interrupt(*_: object) -> None:
     raise KeyboardInterrupt
 
 
-def _start_run(trial: Trial, run_dir: Path) -> subprocess.Popen:
+def _start_run(trial: Trial, run_dir: Path, mpc_helper: bool) -> subprocess.Popen:
     if run_dir.exists():  # an unfinished run from an interrupted batch: start it afresh
         shutil.rmtree(run_dir)
     run_dir.mkdir(parents=True)
@@ -151,6 +159,7 @@ def _start_run(trial: Trial, run_dir: Path) -> subprocess.Popen:
         str(trial.seed),
         "--out",
         str(run_dir),
+        "--mpc-helper" if mpc_helper else "--no-mpc-helper",
         "--exit-with-parent",
     ]
     with (run_dir / "mission.log").open("w") as log:

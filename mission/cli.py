@@ -95,6 +95,13 @@ def build_parser() -> OneLineArgumentParser:
         help="every vehicle also streams here (QGroundControl, MAVProxy); use with --realtime",
     )
     add_link_arguments(run)
+    run.add_argument(
+        "--mpc-helper",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the ground station shares the support MPCs with a helper process "
+        "(default: with two or more cores; same results either way)",
+    )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
     batch = commands.add_parser(
@@ -187,6 +194,7 @@ def _run(args) -> int:
         args.signing_key.resolve() if args.signing_key else None,
         args.observer,
         link,
+        args.mpc_helper,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     try:

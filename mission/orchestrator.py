@@ -43,6 +43,7 @@ class RunOptions:
     signing_key: Path | None = None  # the key file, passed to every process
     observer: str | None = None  # HOST:PORT every vehicle also streams to
     link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
+    mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
 
 
 @dataclass
@@ -111,6 +112,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         children.append(work)
         ports["work"], _ = _wait_banner(work)
         addresses = ",".join(f"{n}=127.0.0.1:{ports[n]}" for n in names)
+        helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
         gcs = _start(
             options.out_dir,
             "ground_station",
@@ -123,6 +125,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
                 addresses,
                 "--out",
                 str(options.out_dir),
+                *helper,
                 *common,
             ],
         )
@@ -152,6 +155,11 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         summary["link"] = json.loads(link_file.read_text())
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
+
+
+def _flag(name: str, on: bool) -> str:
+    """--NAME or --no-NAME."""
+    return f"--{name}" if on else f"--no-{name}"
 
 
 def _raise_interrupt(*_: Any) -> None:

@@ -111,7 +111,7 @@ def test_rerunning_an_unfinished_run_starts_from_an_empty_directory(tmp_path):
     run_dir.mkdir(parents=True)
     (run_dir / "gcs.tlog").write_bytes(b"partial")
     missing = str(tmp_path / "no-such-scenario.yaml")  # the child fails at once: no real run
-    process = _start_run(Trial(missing, "along", "ac", 0), run_dir)
+    process = _start_run(Trial(missing, "along", "ac", 0), run_dir, mpc_helper=False)
     assert process.wait(timeout=60) != 0
     assert sorted(path.name for path in run_dir.iterdir()) == ["mission.log"]
     assert "no-such-scenario.yaml" in (run_dir / "mission.log").read_text()
@@ -190,3 +190,10 @@ def test_a_terminated_batch_leaves_no_process_behind(tmp_path):
     left = subprocess.run(["pgrep", "-f", "--", str(out)], capture_output=True, text=True)
     assert left.stdout.split() == []
     assert not list(out.glob("runs/*/summary.json"))  # nothing half-finished counts as done
+
+
+def test_a_batch_gives_runs_an_mpc_helper_only_where_each_has_a_core_for_it():
+    from mission.batch import helper_has_a_core
+
+    assert helper_has_a_core(1, 2) and helper_has_a_core(2, 4)
+    assert not helper_has_a_core(2, 2) and not helper_has_a_core(1, 1)

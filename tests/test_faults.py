@@ -28,9 +28,9 @@ def scenario(tmp_path) -> Path:
     return path
 
 
-def _start_run(scenario: Path, out: Path) -> subprocess.Popen:
+def _start_run(scenario: Path, out: Path, *extra: str) -> subprocess.Popen:
     return subprocess.Popen(
-        [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out)],
+        [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out), *extra],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -115,11 +115,12 @@ def test_a_killed_support_is_dropped_then_taken_back(scenario, tmp_path):
 
 def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(scenario, tmp_path):
     out = tmp_path / "run"
-    run = _start_run(scenario, out)
+    run = _start_run(scenario, out, "--mpc-helper")
     try:
         _wait_cycles(out, 40)
         gcs = _pids(f"-m ground_station .*{scenario}")
         assert len(gcs) == 1
+        assert len(_pids("ground_station.mpc_helper")) == 1
         subprocess.run(["kill", "-9", *gcs], check=True)
         _, stderr = run.communicate(timeout=120)
     finally:
@@ -130,6 +131,10 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
     trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
     assert len(trace.ticks) >= 40  # every flushed cycle is there and parses
     assert _pids(str(scenario)) == []
+    deadline = time.monotonic() + 10  # the helper ends at the end of its input
+    while _pids("ground_station.mpc_helper") and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert _pids("ground_station.mpc_helper") == []
 
 
 def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp_path):
@@ -155,8 +160,8 @@ def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp
         fuzzer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         for i, datagram in enumerate(datagrams):  # while it connects, uploads and flies
             fuzzer.sendto(datagram, address)
-            if i % 200 == 199:
-                time.sleep(0.002)
+            if i % 100 == 99:  # spread over ~2 s: a burst overflows the socket's buffer
+                time.sleep(0.02)
         fuzzer.close()
         _, stderr = run.communicate(timeout=300)
     finally:

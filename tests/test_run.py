@@ -56,6 +56,14 @@ def _children_of(scenario: Path) -> list[str]:
     return found.stdout.split()
 
 
+def _helpers() -> list[str]:
+    """Ground-station MPC helper processes still alive."""
+    found = subprocess.run(
+        ["pgrep", "-f", "ground_station.mpc_helper"], capture_output=True, text=True
+    )
+    return found.stdout.split()
+
+
 def _run(scenario: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out), *extra],
@@ -67,7 +75,7 @@ def _run(scenario: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
 
 
 def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path):
-    result = _run(scenario, tmp_path / "a", "--seed", "2")
+    result = _run(scenario, tmp_path / "a", "--seed", "2", "--mpc-helper")
     assert result.returncode == 0, result.stderr
     assert "completed at" in result.stdout
     summary = json.loads((tmp_path / "a" / "summary.json").read_text())
@@ -80,6 +88,7 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert summary["mpc_solve_ms"]["median"] > 0
     assert (tmp_path / "a" / "gcs.tlog").stat().st_size > 0
     assert _children_of(scenario) == []
+    assert _helpers() == []
     analyzed = subprocess.run(
         [sys.executable, "-m", "mission", "analyze", str(tmp_path / "a"), "--plots"],
         capture_output=True,
@@ -100,10 +109,13 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert metrics == {k: summary[k] for k in metrics}, "the tlog alone gives the same metrics"
     assert summary["scenario_source"] == str(scenario)
 
-    # The same seed again, this time with every link signed: identical results.
+    # The same seed again, with every link signed and every MPC solved in the ground station
+    # (no helper process): identical results.
     key = tmp_path / "link.key"
     key.write_bytes(bytes(range(32)))
-    again = _run(scenario, tmp_path / "b", "--seed", "2", "--signing-key", str(key))
+    again = _run(
+        scenario, tmp_path / "b", "--seed", "2", "--signing-key", str(key), "--no-mpc-helper"
+    )
     assert again.returncode == 0, again.stderr
     second = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert _steady(summary) == _steady(second)

@@ -1,0 +1,76 @@
+"""``python -m ground_station.mpc_helper``: a process that solves support MPCs for the ground
+station, so two cores share a cycle's solves.
+
+It reads pickled frames on stdin and answers on stdout: first the scenario (it builds its own
+world, sigma_0 map and solver, the same as the ground station's), then lists of
+:class:`~ground_station.support_mpc.PlanRequest`, each answered with the list of plans or an
+error text. A frame is a 4-byte big-endian length and a pickle; both ends are this program.
+The helper ends at end of input, i.e. when the ground station closes the pipe or dies.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import pickle
+import signal
+import struct
+import sys
+import traceback
+from typing import Any, BinaryIO
+
+HEADER = struct.Struct(">I")
+
+
+def write_frame(stream: BinaryIO, value: Any) -> None:
+    """One length-prefixed pickle, flushed."""
+    data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    stream.write(HEADER.pack(len(data)) + data)
+    stream.flush()
+
+
+def read_frame(stream: BinaryIO) -> Any:
+    """The next frame's value; EOFError at a clean or broken end of the stream."""
+    header = stream.read(HEADER.size)
+    if len(header) < HEADER.size:
+        raise EOFError
+    (size,) = HEADER.unpack(header)
+    data = stream.read(size)
+    if len(data) < size:
+        raise EOFError
+    return pickle.loads(data)
+
+
+def serve(requests: BinaryIO, answers: BinaryIO) -> None:
+    """Build the solver from the first frame, then answer request lists until end of input."""
+    from ground_station.support_mpc import SupportMpc
+    from mission.world import World
+
+    try:
+        scenario = read_frame(requests)
+    except EOFError:
+        return
+    world = World(scenario)
+    sigma0 = world.sigma0_map().sigma_m
+    mpc = SupportMpc(scenario.control, world.map_grid(), world.camera, sigma0)
+    while True:
+        try:
+            batch = read_frame(requests)
+        except EOFError:
+            return
+        try:
+            answer: Any = [mpc.plan(request, world.camera.observable) for request in batch]
+        except Exception:  # reported to the ground station, which stops the run with it
+            answer = traceback.format_exc(limit=3)
+        write_frame(answers, answer)
+
+
+def main() -> int:
+    """Serve on stdin/stdout; Ctrl-C is the ground station's to handle (it closes the pipe)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with contextlib.suppress(BrokenPipeError):  # the ground station went away
+        serve(sys.stdin.buffer, sys.stdout.buffer)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

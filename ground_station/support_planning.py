@@ -1,0 +1,146 @@
+"""Who solves a cycle's support MPCs: this process alone, or this process and a helper.
+
+A run is a chain that keeps one core busy at a time, and the support MPCs are most of the
+ground station's cycle. With a helper process (:mod:`ground_station.mpc_helper`) the second
+core takes part of them: the solves expected to take longest (by each support's last solve
+time) are shared out longest first, each to whichever side has less to do, as in LPT
+scheduling. A solve is a pure function of its request, so the plans are the same bit for bit
+whichever process made them; only the timing differs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import subprocess
+import sys
+from collections.abc import Callable
+
+import numpy as np
+
+from ground_station.mpc_helper import read_frame, write_frame
+from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
+from mission.cli_common import child_environment
+from mission.settings import Scenario
+
+Observable = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+class HelperError(RuntimeError):
+    """The helper process failed a solve (its traceback is the message)."""
+
+
+class LocalPlanner:
+    """Every support MPC solved here, one after another."""
+
+    def __init__(self, mpc: SupportMpc, observable: Observable) -> None:
+        self.mpc = mpc
+        self.observable = observable
+
+    def plan_all(self, requests: list[PlanRequest]) -> dict[str, SupportPlan]:
+        """The plans, by support name, in the order of ``requests``."""
+        return {r.name: self.mpc.plan(r, self.observable) for r in requests}
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+
+class HelperPlanner(LocalPlanner):
+    """Support MPCs shared between this process and one helper process.
+
+    If the helper dies, its share is solved here from then on (same plans, a note on stderr).
+    """
+
+    def __init__(self, mpc: SupportMpc, observable: Observable, helper: MpcHelper) -> None:
+        super().__init__(mpc, observable)
+        self.helper: MpcHelper | None = helper
+        self._expected_ms: dict[str, float] = {}
+
+    def plan_all(self, requests: list[PlanRequest]) -> dict[str, SupportPlan]:
+        """The plans, by support name, in the order of ``requests``."""
+        theirs, ours = self._share(requests)
+        if theirs and not self._call(lambda h: h.send(theirs)):
+            theirs, ours = [], list(requests)
+        plans = {r.name: self.mpc.plan(r, self.observable) for r in ours}
+        if theirs:
+            answer = self._call(lambda h: h.receive())
+            if answer is None:
+                plans.update((r.name, self.mpc.plan(r, self.observable)) for r in theirs)
+            elif isinstance(answer, str):
+                raise HelperError(answer)
+            else:
+                plans.update((request.name, plan) for request, plan in zip(theirs, answer))
+        for name, plan in plans.items():
+            self._expected_ms[name] = plan.solve_ms
+        return {r.name: plans[r.name] for r in requests}
+
+    def _share(self, requests: list[PlanRequest]) -> tuple[list[PlanRequest], list[PlanRequest]]:
+        """(the helper's requests, this process's): longest expected first, each to the side
+        with less to do; nothing for the helper when it is gone or there is one request."""
+        if self.helper is None or len(requests) < 2:
+            return [], list(requests)
+        expected = {r.name: self._expected_ms.get(r.name, 1.0) for r in requests}
+        theirs: list[PlanRequest] = []
+        ours: list[PlanRequest] = []
+        theirs_ms = ours_ms = 0.0
+        for request in sorted(requests, key=lambda r: -expected[r.name]):
+            if not theirs or theirs_ms < ours_ms:  # ties stay here: no round trip
+                theirs.append(request)
+                theirs_ms += expected[request.name]
+            else:
+                ours.append(request)
+                ours_ms += expected[request.name]
+        return theirs, ours
+
+    def _call(self, action):
+        """``action(helper)``; None (and the helper dropped) if the helper is gone."""
+        if self.helper is None:
+            return None
+        try:
+            result = action(self.helper)
+            return True if result is None else result
+        except (EOFError, OSError):
+            print("ground station: MPC helper stopped; solving its share here", file=sys.stderr)
+            self.close()
+            return None
+
+    def close(self) -> None:
+        """Stop the helper."""
+        helper, self.helper = self.helper, None
+        if helper is not None:
+            helper.close()
+
+
+class MpcHelper:
+    """The helper process: started early (it builds its solver while the ground station
+    connects), fed request lists, stopped by closing its input."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "ground_station.mpc_helper"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            env=child_environment(),
+        )
+        self.send(scenario)
+
+    def send(self, value) -> None:
+        """One frame to the helper (BrokenPipeError if it is gone)."""
+        assert self.process.stdin is not None
+        write_frame(self.process.stdin, value)
+
+    def receive(self):
+        """The helper's next answer (EOFError if it is gone)."""
+        assert self.process.stdout is not None
+        return read_frame(self.process.stdout)
+
+    def close(self) -> None:
+        """Close its input, so it ends, and wait for it."""
+        for stream in (self.process.stdin, self.process.stdout):
+            if stream is not None:
+                with contextlib.suppress(OSError):
+                    stream.close()
+        try:
+            self.process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()

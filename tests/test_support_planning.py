@@ -1,0 +1,111 @@
+"""Sharing the support MPCs with a helper process: the same plans, shared longest first, and a
+dead helper's share solved here."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
+from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
+from ground_station.work_mpc import predict_work
+from mission.plan_files import read_plan
+
+
+@pytest.fixture(scope="module")
+def local(along_world) -> LocalPlanner:
+    scenario = along_world.scenario
+    mpc = SupportMpc(
+        scenario.control,
+        along_world.map_grid(),
+        along_world.camera,
+        along_world.sigma0_map().sigma_m,
+    )
+    return LocalPlanner(mpc, along_world.camera.observable)
+
+
+def _requests(world, mpc: SupportMpc, index: int) -> list[PlanRequest]:
+    """The three supports' problems with the work UAV at waypoint ``index`` (raised G)."""
+    control = world.scenario.control
+    plan = read_plan(world.scenario)
+    work = predict_work(
+        plan.work[index], index + 1, plan.work, control.horizon_steps, control.d_max_work_m, 0.1
+    )
+    g = world.sigma0_map().sigma_m.copy()
+    g[20:26, 10:30, 5:12] += 1.5  # a worse-than-predicted region for the escape starts
+    offset = np.array([0.4, -0.3, 0.2])
+    return [
+        mpc.request(
+            f"support-{n + 1}",
+            plan.supports[n][index] + offset,
+            plan.supports[n],
+            work.path,
+            work.indices,
+            g,
+            escape=n == 0,
+        )
+        for n in range(len(plan.supports))
+    ]
+
+
+def _same(a: SupportPlan, b: SupportPlan) -> bool:
+    return (
+        np.array_equal(a.path, b.path)
+        and a.status == b.status
+        and np.array_equal(a.blocked, b.blocked)
+        and a.resolved == b.resolved
+        and np.array_equal(a.anchors, b.anchors)
+    )
+
+
+def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along_world, local):
+    helper = MpcHelper(along_world.scenario)
+    shared = HelperPlanner(local.mpc, local.observable, helper)
+    try:
+        for index in (2, 6, 9):
+            requests = _requests(along_world, local.mpc, index)
+            expected = local.plan_all(requests)
+            got = shared.plan_all(requests)
+            assert list(got) == [r.name for r in requests]
+            assert all(_same(got[name], expected[name]) for name in expected)
+        assert shared.helper is not None  # it was used throughout, not dropped
+    finally:
+        shared.close()
+    assert helper.process.returncode == 0
+
+
+def test_a_dead_helpers_share_is_solved_here(along_world, local, capfd):
+    helper = MpcHelper(along_world.scenario)
+    shared = HelperPlanner(local.mpc, local.observable, helper)
+    requests = _requests(along_world, local.mpc, 4)
+    shared.plan_all(requests)  # the helper answered once
+    helper.process.kill()
+    helper.process.wait()
+    got = shared.plan_all(requests)
+    expected = local.plan_all(requests)
+    assert all(_same(got[name], expected[name]) for name in expected)
+    assert shared.helper is None
+    assert "MPC helper stopped" in capfd.readouterr().err
+    shared.plan_all(requests)  # and it goes on without one
+    shared.close()
+
+
+def test_the_longest_expected_solve_goes_to_the_helper_the_rest_balance(local):
+    shared = HelperPlanner(local.mpc, local.observable, helper=None)  # type: ignore[arg-type]
+    shared.helper = object()  # a stand-in: only the sharing is under test
+
+    def named(*names: str) -> list[PlanRequest]:
+        return [PlanRequest(n, *[None] * 7, False) for n in names]  # type: ignore[arg-type]
+
+    def share(*names: str) -> tuple[list[str], list[str]]:
+        theirs, ours = shared._share(named(*names))
+        return [r.name for r in theirs], [r.name for r in ours]
+
+    assert share("a", "b", "c") == (["a"], ["b", "c"])  # no history: the first goes out
+    assert share("a") == ([], ["a"])  # one solve: no round trip
+    shared._expected_ms = {"a": 2.0, "b": 9.0, "c": 3.0}
+    assert share("a", "b", "c") == (["b"], ["c", "a"])
+    shared._expected_ms = {"a": 4.0, "b": 4.0, "c": 3.0, "d": 3.0}
+    assert share("a", "b", "c", "d") == (["a", "d"], ["b", "c"])  # 7 ms each
+    shared.helper = None
+    assert share("a", "b") == ([], ["a", "b"])
