@@ -108,12 +108,17 @@ class UdpEndpoint:
         bind: Address = ("127.0.0.1", 0),
         link: LinkSettings | None = None,
         link_seed: int = 0,
+        sock: socket.socket | None = None,
     ) -> None:
+        """Bind a new socket to ``bind``, or take ``sock``, already bound (e.g. inherited from
+        the process that started this one)."""
         self.codec = codec
         self.counters = LinkCounters()
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        if sock is None:
+            sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+            sock.bind(bind)
+        self.sock = sock
         self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 21)
-        self.sock.bind(bind)
         self.sock.setblocking(False)
         self.link = (
             ImpairedLink(self.sock, link, link_seed) if link is not None and link.impaired else None

@@ -9,9 +9,11 @@ from __future__ import annotations
 import json
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -23,8 +25,8 @@ from mission.link_impairment import LinkSettings
 from mission.plan_files import vehicle_names
 from mission.settings import Scenario
 
-_BANNER = re.compile(r"listening on [\d.]+:(\d+)(?:, truth port (\d+))?")
-BANNER_TIMEOUT_S = 60.0
+_BANNER = re.compile(r"listening on [\d.]+:(\d+)")
+SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
 
 
 class RunFailed(RuntimeError):
@@ -78,40 +80,25 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
             "--exit-with-parent",
         ]
         names = vehicle_names(scenario.task.supports)
-        ports: dict[str, int] = {}
-        truth_ports: list[int] = []
-        supports = [  # started together: they do not depend on each other
-            _start(
-                options.out_dir,
-                name,
-                ["-m", "vehicle_sim", "--vehicle", name, "--port", "0", *observer, *common],
+        # Every socket is bound here and inherited, so all processes start at once: the
+        # ground station knows every address before any vehicle has printed its banner.
+        sockets = {name: _bound_udp() for name in names}
+        truth_sockets = {name: _bound_udp() for name in names[1:]}
+        truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
+        for name in names:
+            fds = [sockets[name].fileno()]
+            arguments = ["-m", "vehicle_sim", "--vehicle", name, "--socket-fd", str(fds[0])]
+            if name in truth_sockets:
+                fds.append(truth_sockets[name].fileno())
+                arguments += ["--truth-socket-fd", str(fds[1])]
+            else:
+                arguments += truth_out
+            children.append(
+                _start(options.out_dir, name, [*arguments, *observer, *common], pass_fds=fds)
             )
-            for name in names[1:]
-        ]
-        children.extend(supports)
-        for child in supports:
-            port, truth = _wait_banner(child)
-            ports[child.name] = port
-            truth_ports.append(truth)
-        truth_out = [a for p in truth_ports for a in ("--truth-out", f"127.0.0.1:{p}")]
-        work = _start(
-            options.out_dir,
-            "work",
-            [
-                "-m",
-                "vehicle_sim",
-                "--vehicle",
-                "work",
-                "--port",
-                "0",
-                *truth_out,
-                *observer,
-                *common,
-            ],
-        )
-        children.append(work)
-        ports["work"], _ = _wait_banner(work)
-        addresses = ",".join(f"{n}=127.0.0.1:{ports[n]}" for n in names)
+        addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
+        for sock in (*sockets.values(), *truth_sockets.values()):
+            sock.close()  # the children hold them now
         helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
         gcs = _start(
             options.out_dir,
@@ -166,7 +153,19 @@ def _raise_interrupt(*_: Any) -> None:
     raise KeyboardInterrupt
 
 
-def _start(out_dir: Path, name: str, arguments: list[str]) -> Child:
+def _bound_udp() -> socket.socket:
+    """A UDP socket bound to a free loopback port."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    return sock
+
+
+def _address_of(sock: socket.socket) -> str:
+    host, port = sock.getsockname()[:2]
+    return f"{host}:{port}"
+
+
+def _start(out_dir: Path, name: str, arguments: list[str], pass_fds: Sequence[int] = ()) -> Child:
     log = out_dir / f"{name}.log"
     handle = log.open("w")
     process = subprocess.Popen(
@@ -175,35 +174,31 @@ def _start(out_dir: Path, name: str, arguments: list[str]) -> Child:
         stderr=handle,
         stdin=subprocess.DEVNULL,
         env=child_environment(),
+        pass_fds=tuple(pass_fds),
     )
     handle.close()
     return Child(name, process, log)
 
 
-def _wait_banner(child: Child) -> tuple[int, int | None]:
-    deadline = time.monotonic() + BANNER_TIMEOUT_S
-    while time.monotonic() < deadline:
-        match = _BANNER.search(child.log.read_text())
-        if match:
-            return int(match.group(1)), int(match.group(2)) if match.group(2) else None
-        if child.process.poll() is not None:
-            break
-        time.sleep(0.05)
-    tail = child.log.read_text().strip().splitlines()[-1:] or ["no output"]
-    raise RunFailed(f"{child.name} did not start: {tail[0]}")
-
-
 def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
-    """Wait for the ground station; a dead required vehicle ends the run with an error."""
-    while gcs.process.poll() is None:
+    """Wait for the ground station; a dead required vehicle, or one that never started,
+    ends the run with an error."""
+    while True:
+        try:
+            gcs.process.wait(timeout=SUPERVISE_S)
+            return
+        except subprocess.TimeoutExpired:
+            pass
         for child in children:
             if child is gcs or child.process.poll() is None:
                 continue
+            if not _BANNER.search(child.log.read_text()):
+                tail = child.log.read_text().strip().splitlines()[-1:] or ["no output"]
+                raise RunFailed(f"{child.name} did not start: {tail[0]}")
             if child.name in required:
                 raise RunFailed(
                     f"{child.name} died (exit status {child.process.returncode}, see {child.log})"
                 )
-        time.sleep(0.1)
 
 
 def _stop_all(children: list[Child]) -> None:

@@ -150,6 +150,12 @@ CASES = [
     ("gcs-vehicles", lambda t: ["--vehicles", "work=localhost"], ["--vehicles"]),
     ("vehicle-name", lambda t: ["--vehicle", "support-x"], ["support-x"]),
     ("vehicle-speedup", lambda t: ["--vehicle", "work", "--speedup", "-1"], ["--speedup"]),
+    ("vehicle-socket-fd", lambda t: ["--vehicle", "work", "--socket-fd", "987"], ["--socket-fd"]),
+    (
+        "vehicle-socket-fd-port",
+        lambda t: ["--vehicle", "work", "--socket-fd", "3", "--port", "14560"],
+        ["--socket-fd", "--port"],
+    ),
     # --- signing keys ------------------------------------------------------------------
     ("key-missing", lambda t: [*RUN, "--signing-key", str(t / "none.key")], ["none.key"]),
     (

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import socket
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -61,6 +62,19 @@ def build_parser() -> OneLineArgumentParser:
         "--truth-port", type=int, help="support: port for the work UAV's truth (default port + 100)"
     )
     parser.add_argument(
+        "--socket-fd",
+        type=int,
+        metavar="FD",
+        help="use this inherited, already bound UDP socket instead of --host/--port "
+        "(mission run binds every socket first, so all processes start at once)",
+    )
+    parser.add_argument(
+        "--truth-socket-fd",
+        type=int,
+        metavar="FD",
+        help="support: the same for the truth port",
+    )
+    parser.add_argument(
         "--truth-out",
         action="append",
         default=None,
@@ -88,6 +102,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     identity = _identity(args.vehicle)
     if args.speedup is not None and not (0 < args.speedup <= 1000):
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
+    if args.socket_fd is not None and args.port is not None:
+        raise InputError("command line", "--socket-fd", "cannot be combined with --port")
     port = args.port if args.port is not None else identity.default_port()
     _check_port(port, "--port", allow_any=True)
     outs = [_address(text, "--out") for text in args.out]
@@ -112,14 +128,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         codec = MavlinkCodec(identity.system_id, 1, key)
         endpoint = UdpEndpoint(
-            codec, (args.host, port), link, link_seed=args.seed * 1000 + identity.system_id
+            codec,
+            (args.host, port),
+            link,
+            link_seed=args.seed * 1000 + identity.system_id,
+            sock=_inherited_socket(args.socket_fd, "--socket-fd"),
         )
         if not identity.is_work:
             truth_port = args.truth_port
             if truth_port is None:
                 truth_port = port + TRUTH_PORT_OFFSET if port else 0
             _check_port(truth_port, "--truth-port", allow_any=True)
-            truth_receiver = TruthReceiver(truth_port, args.host)
+            truth_receiver = TruthReceiver(
+                truth_port,
+                args.host,
+                sock=_inherited_socket(args.truth_socket_fd, "--truth-socket-fd"),
+            )
     except OSError as error:
         raise InputError("command line", "--port", f"cannot listen: {error.strerror}") from None
 
@@ -149,6 +173,24 @@ def main(argv: Sequence[str] | None = None) -> int:
             if channel is not None:
                 channel.close()
     return 0
+
+
+def _inherited_socket(fd: int | None, flag: str) -> socket.socket | None:
+    """The UDP socket open on ``fd`` (None without one); InputError if it is not one."""
+    if fd is None:
+        return None
+    try:
+        sock = socket.socket(fileno=fd)
+    except OSError:
+        raise InputError("command line", flag, f"{fd} is not an open socket") from None
+    if (
+        sock.family != socket.AF_INET
+        or sock.type != socket.SOCK_DGRAM
+        or sock.getsockname()[1] == 0
+    ):
+        sock.detach()
+        raise InputError("command line", flag, f"{fd} is not a bound UDP socket")
+    return sock
 
 
 def _identity(name: str) -> VehicleIdentity:

@@ -14,12 +14,14 @@ Each step ends with SYSTEM_TIME (the step marker the ground station waits for).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import select
 import signal
+import socket
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -117,11 +119,21 @@ class VehicleServer:
         sources: list[Any] = [self.endpoint]
         if self.truth_receiver is not None:
             sources.append(self.truth_receiver)
+        with _signal_wakeup() as woken:  # a signal ends the wait at once, not at the timeout
+            sources.append(woken)
+            self._serve(sources)
+
+    def _serve(self, sources: list[Any]) -> None:
+        assert self.vehicle is not None
+        woken = sources[-1]
         while not self.stopping:
             now = time.monotonic()
             wait = max(0.0, min(MAX_WAIT_WALL_S, self._next_deadline(now) - now))
             readable, _, _ = select.select(sources, [], [], wait)
             now = time.monotonic()
+            if woken in readable:
+                with contextlib.suppress(OSError):
+                    woken.recv(256)
             if self.truth_receiver is not None and self.truth_receiver in readable:
                 self.truth_receiver.drain()
             if self.endpoint in readable:
@@ -277,6 +289,26 @@ class VehicleServer:
             f"{self.stats.truth_waits_timed_out}, stale truth {stale}, "
             f"steps resent {self.stats.resent_steps}"
         )
+
+
+@contextlib.contextmanager
+def _signal_wakeup() -> Iterator[socket.socket]:
+    """A socket that becomes readable when a signal arrives (signal.set_wakeup_fd); the
+    previous wakeup fd is restored after. Outside the main thread, one that never wakes."""
+    reader, writer = socket.socketpair()
+    reader.setblocking(False)
+    writer.setblocking(False)
+    try:
+        previous = signal.set_wakeup_fd(writer.fileno(), warn_on_full_buffer=False)
+    except ValueError:  # not the main thread
+        previous = None
+    try:
+        yield reader
+    finally:
+        if previous is not None:
+            signal.set_wakeup_fd(previous)
+        reader.close()
+        writer.close()
 
 
 def install_signal_handlers(stop: Callable[..., None], die_with_parent: bool) -> None:

@@ -8,6 +8,7 @@ never listens on these ports, so truth cannot leak into estimation.
 
 from __future__ import annotations
 
+import socket
 from collections import OrderedDict
 
 import numpy as np
@@ -44,8 +45,10 @@ class TruthReceiver:
     from a work vehicle at all; a support running alone publishes not-valid observations.
     """
 
-    def __init__(self, port: int, host: str = "127.0.0.1") -> None:
-        self.endpoint = UdpEndpoint(MavlinkCodec(0, 0), (host, port))
+    def __init__(
+        self, port: int, host: str = "127.0.0.1", sock: socket.socket | None = None
+    ) -> None:
+        self.endpoint = UdpEndpoint(MavlinkCodec(0, 0), (host, port), sock=sock)
         self.samples: OrderedDict[int, np.ndarray] = OrderedDict()
         self.stale_uses = 0
 
