@@ -5,6 +5,7 @@ Benchmarks measure medians over repeats on this machine; targets are the issues'
 
 from __future__ import annotations
 
+import os
 import statistics
 import subprocess
 import sys
@@ -247,28 +248,35 @@ def _scipy_over_casadi(world, plan, problems: int) -> float:
     return statistics.median(ratios) if ratios else float("nan")
 
 
-def bench_runs(trials: int = 15, jobs: int = 2) -> list[BenchResult]:
-    """One lockstep run per scenario and method: Along AC's real-time factor and the wall time
-    of the full Table 3 batch estimated as trials x (sum of the four runs' walls) / jobs."""
+def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchResult]:
+    """Lockstep runs: Along AC's real-time factor, the median of ``repeats`` runs as
+    ``mission run`` makes them (MPC helper where there is a core for it); and the wall time of
+    the full Table 3 batch, estimated as trials x (sum of one run per scenario and method,
+    made as the batch makes them) / jobs."""
     import tempfile
     from pathlib import Path
 
+    from mission.batch import helper_has_a_core
     from mission.orchestrator import RunOptions, run_mission
     from mission.scenario import load_scenario
 
-    walls, along_ac = [], float("nan")
+    factors, walls = [], []
+    in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)
     with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
+        along = load_scenario("along")
+        for repeat in range(repeats):
+            out = Path(temp) / f"along-ac-{repeat}"
+            factors.append(run_mission(RunOptions("along", "ac", 0, out), along)["realtime_factor"])
         for name in ("along", "wall"):
             scenario = load_scenario(name)
             for method in ("ac", "nac"):
-                out = Path(temp) / f"{name}-{method}"
-                summary = run_mission(RunOptions(name, method, 0, out), scenario)
-                walls.append(summary["wall_time_s"])
-                if (name, method) == ("along", "ac"):
-                    along_ac = summary["realtime_factor"]
+                out = Path(temp) / f"batch-{name}-{method}"
+                options = RunOptions(name, method, 0, out, mpc_helper=in_batch)
+                walls.append(run_mission(options, scenario)["wall_time_s"])
+    factor = statistics.median(factors)
     estimate = trials * sum(walls) / jobs
     return [
-        BenchResult("realtime_factor_lockstep", along_ac, "x", ">= 30", along_ac >= 30),
+        BenchResult("realtime_factor_lockstep", factor, "x", ">= 30", factor >= 30),
         BenchResult("table3_wall_s_estimate", estimate, "s", "<= 600", estimate <= 600),
     ]
 
