@@ -6,6 +6,7 @@ world, sigma_0 map and solver, the same as the ground station's), then lists of
 :class:`~ground_station.support_mpc.PlanRequest`, each answered with the list of plans or an
 error text. A frame is a 4-byte big-endian length and a pickle; both ends are this program.
 The helper ends at end of input, i.e. when the ground station closes the pipe or dies.
+``--for LABEL`` (the ground station passes its output directory) only names it in ``ps``.
 """
 
 from __future__ import annotations

@@ -222,7 +222,7 @@ class GroundStation:
         """Connect, upload, arm, then cycle until done or timeout; return a summary."""
         start_wall = time.monotonic()
         if self.config.mpc_helper:  # it builds its solver while we connect
-            self._helper = MpcHelper(self.scenario)
+            self._helper = MpcHelper(self.scenario, str(self.config.out_dir))
         self.connect()
         waypoints = self.upload_missions()
         self.arm_all()

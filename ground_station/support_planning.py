@@ -114,9 +114,16 @@ class MpcHelper:
     """The helper process: started early (it builds its solver while the ground station
     connects), fed request lists, stopped by closing its input."""
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, label: str = "") -> None:
+        """Start the helper and send it ``scenario``; ``label`` (e.g. the run's directory)
+        goes on its command line, so ``ps`` tells whose helper it is."""
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "ground_station.mpc_helper"],
+            [
+                sys.executable,
+                "-m",
+                "ground_station.mpc_helper",
+                *(["--for", label] if label else []),
+            ],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             env=child_environment(),

@@ -120,7 +120,7 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
         _wait_cycles(out, 40)
         gcs = _pids(f"-m ground_station .*{scenario}")
         assert len(gcs) == 1
-        assert len(_pids("ground_station.mpc_helper")) == 1
+        assert len(_pids(f"ground_station.mpc_helper --for {out}")) == 1
         subprocess.run(["kill", "-9", *gcs], check=True)
         _, stderr = run.communicate(timeout=120)
     finally:
@@ -132,9 +132,9 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
     assert len(trace.ticks) >= 40  # every flushed cycle is there and parses
     assert _pids(str(scenario)) == []
     deadline = time.monotonic() + 10  # the helper ends at the end of its input
-    while _pids("ground_station.mpc_helper") and time.monotonic() < deadline:
+    while _pids(f"ground_station.mpc_helper --for {out}") and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert _pids("ground_station.mpc_helper") == []
+    assert _pids(f"ground_station.mpc_helper --for {out}") == []
 
 
 def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp_path):
