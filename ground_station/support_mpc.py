@@ -33,6 +33,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -64,36 +65,42 @@ ESCAPE_STARTS = 1  # escape starts solved: the cheapest of six where it starts
 CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
-def compiled_nlp(solver: ca.Function, build_dir: str) -> str | None:
+def compiled_nlp(solver: ca.Function, fallback_dir: Callable[[], str]) -> str | None:
     """The NLP's functions of ``solver`` compiled into a shared library with the system C
     compiler (about 1.5x faster solves than interpreting them), or None without one.
 
-    The library is cached by the hash of its C source (under ``$XDG_CACHE_HOME`` or
-    ``~/.cache``), so runs after the first skip the compiler.
+    The library is cached (under ``$XDG_CACHE_HOME`` or ``~/.cache``) by the hash of the
+    serialised solver, the casadi version, the compiler and its flags: a run after the first
+    neither generates C nor compiles. The C source is generated in a scratch directory that is
+    gone on return; where the cache cannot be written, the library goes to ``fallback_dir()``.
     """
     compiler = shutil.which("gcc") or shutil.which("cc")
     if compiler is None:
         return None
-    with contextlib.chdir(build_dir):  # casadi writes the C file to the working directory
-        solver.generate_dependencies("support_mpc_nlp.c")
-    source = Path(build_dir) / "support_mpc_nlp.c"
-    digest = hashlib.sha256(source.read_bytes() + " ".join(COMPILE_FLAGS).encode()).hexdigest()
-    for directory in (_cache_dir(), Path(build_dir)):
-        library = directory / f"support_mpc_{digest[:16]}.so"
-        if library.is_file():
-            return str(library)
-        try:
-            directory.mkdir(parents=True, exist_ok=True)
-            partial = directory / f".{library.name}.{os.getpid()}.part"
-            subprocess.run(
-                [compiler, *COMPILE_FLAGS, str(source), "-o", str(partial)],
-                check=True,
-                capture_output=True,
-            )
-            os.replace(partial, library)
-            return str(library)
-        except (OSError, subprocess.CalledProcessError):
-            continue
+    recipe = f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}\n{solver.serialize()}"
+    name = f"support_mpc_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
+    cached = _cache_dir() / name
+    if cached.is_file():
+        return str(cached)
+    with tempfile.TemporaryDirectory(prefix="support-mpc-c-") as scratch:
+        with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
+            solver.generate_dependencies("support_mpc_nlp.c")
+        source = Path(scratch) / "support_mpc_nlp.c"
+        for directory in (_cache_dir(), None):
+            try:
+                directory = Path(fallback_dir()) if directory is None else directory
+                directory.mkdir(parents=True, exist_ok=True)
+                library = directory / name
+                partial = directory / f".{name}.{os.getpid()}.part"
+                subprocess.run(
+                    [compiler, *COMPILE_FLAGS, str(source), "-o", str(partial)],
+                    check=True,
+                    capture_output=True,
+                )
+                os.replace(partial, library)
+                return str(library)
+            except (OSError, subprocess.CalledProcessError):
+                continue
     return None
 
 
@@ -162,9 +169,7 @@ class SupportMpc:
         half = int(np.ceil(reach / grid.voxel_m))
         self.window = tuple(min(2 * half + 1, n) for n in grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
-        self._build_dir = tempfile.TemporaryDirectory(
-            prefix="support-mpc-", ignore_cleanup_errors=True
-        )
+        self._library_dir: tempfile.TemporaryDirectory | None = None  # only if uncacheable
         self._solver, self._cost = self._build()
         cube = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=3)))
         cube = cube[np.any(cube != 0, axis=1)]
@@ -244,7 +249,7 @@ class SupportMpc:
         constraints = ca.vertcat(*steps, terminal_sq, *shadow)
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": constraints}
         solver = ca.nlpsol("support_mpc", "ipopt", nlp, IPOPT_OPTIONS)
-        library = compiled_nlp(solver, self._build_dir.name)
+        library = compiled_nlp(solver, self._private_library_dir)
         if library is not None:
             solver = ca.nlpsol("support_mpc", "ipopt", library, IPOPT_OPTIONS)
         unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
@@ -252,6 +257,14 @@ class SupportMpc:
             BufferedFunction(solver, ("x", "f"), unbounded),
             BufferedFunction(cost_function, ("f",)),
         )
+
+    def _private_library_dir(self) -> str:
+        """A directory for the compiled NLP that lives as long as this MPC."""
+        if self._library_dir is None:
+            self._library_dir = tempfile.TemporaryDirectory(
+                prefix="support-mpc-", ignore_cleanup_errors=True
+            )
+        return self._library_dir.name
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(corner of the window in world coordinates, the values the NLP takes there: G's

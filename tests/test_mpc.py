@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -223,6 +225,83 @@ def test_building_the_mpc_leaves_no_files_in_the_working_directory(
     mpc = SupportMpc(along_world.scenario.control, along_world.map_grid(), along_world.camera)
     assert mpc.horizon == 5
     assert list(tmp_path.iterdir()) == []
+
+
+def _tiny_solver():
+    """A two-variable NLP: min (x - p)^2 + (y - 2p)^2 with x + y >= 1, solved by IPOPT."""
+    import casadi as ca
+
+    from ground_station.support_mpc import IPOPT_OPTIONS
+
+    x, p = ca.MX.sym("x", 2), ca.MX.sym("p")
+    nlp = {"x": x, "p": p, "f": (x[0] - p) ** 2 + (x[1] - 2 * p) ** 2, "g": x[0] + x[1]}
+    return nlp, IPOPT_OPTIONS
+
+
+def _has_compiler() -> bool:
+    import shutil
+
+    return shutil.which("gcc") is not None or shutil.which("cc") is not None
+
+
+def test_the_compiled_nlp_is_cached_and_no_c_is_generated_on_a_hit(tmp_path, monkeypatch):
+    import tempfile
+
+    import casadi as ca
+
+    from ground_station import support_mpc
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    nlp, options = _tiny_solver()
+    solver = ca.nlpsol("tiny", "ipopt", nlp, options)
+
+    def no_fallback() -> str:
+        raise AssertionError("the cache is writable: no fallback directory")
+
+    first = support_mpc.compiled_nlp(solver, no_fallback)
+    if not _has_compiler():
+        assert first is None
+        return
+    assert first is not None and Path(first).parent == tmp_path / "cache" / "bridge-uav-formation"
+    assert list(scratch.iterdir()) == []  # the C source's scratch directory is gone
+    mtime = Path(first).stat().st_mtime_ns
+
+    def no_scratch(*args, **kwargs):
+        raise AssertionError("a cache hit generates no C")
+
+    monkeypatch.setattr(support_mpc.tempfile, "TemporaryDirectory", no_scratch)
+    again = ca.nlpsol("tiny", "ipopt", nlp, options)
+    assert support_mpc.compiled_nlp(again, no_fallback) == first
+    assert Path(first).stat().st_mtime_ns == mtime
+    compiled = ca.nlpsol("tiny", "ipopt", first, options)
+    expected = solver(x0=[0, 0], p=1.5, lbg=1.0, ubg=np.inf)["x"]
+    np.testing.assert_allclose(compiled(x0=[0, 0], p=1.5, lbg=1.0)["x"], expected, atol=1e-9)
+    np.testing.assert_allclose(expected, [[1.5], [3.0]], atol=1e-4)  # IPOPT tol 1e-4
+
+
+def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monkeypatch):
+    import casadi as ca
+
+    from ground_station import support_mpc
+
+    blocker = tmp_path / "not-a-directory"
+    blocker.write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
+    fallback = tmp_path / "private"
+    nlp, options = _tiny_solver()
+    library = support_mpc.compiled_nlp(
+        ca.nlpsol("tiny", "ipopt", nlp, options), lambda: str(fallback)
+    )
+    if not _has_compiler():
+        assert library is None
+        return
+    assert library is not None and Path(library).parent == fallback
+    solved = ca.nlpsol("tiny", "ipopt", library, options)(x0=[0, 0], p=-1.0, lbg=1.0)["x"]
+    # (x - p, y - 2p) projected onto x + y >= 1 from (-1, -2): the constraint is active
+    np.testing.assert_allclose(solved, [[1.0], [0.0]], atol=1e-4)
 
 
 def _blocked_case(world, mpc: SupportMpc):
