@@ -90,6 +90,9 @@ class VehicleView:
     heard_s: float = 0.0  # simulated time of the last message from it
     lost: bool = False  # silent for link_loss_s: out of fusion and the MPCs
     late: bool = False  # missed the last lockstep marker: not waited for
+    outbox: list[bytes] = field(default_factory=list)  # the cycle's packets, not yet sent
+    queued: list[Any] = field(default_factory=list)  # their messages
+    last_batch: list[Any] = field(default_factory=list)  # the messages last sent together
 
 
 class GroundStation:
@@ -135,6 +138,23 @@ class GroundStation:
         """Send to one vehicle and log the packet."""
         packet = self.endpoint.send(message, [view.address])
         self.tlog.write(self.time_usec, packet)
+
+    def queue_for(self, message: Any, view: VehicleView) -> None:
+        """Log the packet now (its time and sequence number are now's) and send it with the
+        vehicle's other packets of the cycle at :meth:`flush_outboxes`."""
+        packet = self.endpoint.encode(message)
+        self.tlog.write(self.time_usec, packet)
+        view.outbox.append(packet)
+        view.queued.append(message)
+
+    def flush_outboxes(self) -> None:
+        """Each vehicle's queued packets out, in order, in one datagram (commands and tick
+        wake a vehicle once, not three times)."""
+        for view in self.views.values():
+            if view.outbox:
+                self.endpoint.send_packets(view.outbox, [view.address])
+                view.last_batch = view.queued
+                view.outbox, view.queued = [], []
 
     def _log_received(self, message: Any, sender: Address) -> None:
         view = self.by_system.get(message.get_srcSystem())
@@ -233,6 +253,7 @@ class GroundStation:
         self.link_stats["lost_in"] = 0
         completion = None
         pending = self._tick()
+        self.flush_outboxes()
         while pending is not None:
             self._await_step(pending)
             self._check_links(state)
@@ -254,6 +275,7 @@ class GroundStation:
             cycle_time_s = self.sim_time_s
             # the next tick goes out now: the vehicles step while this cycle is written down
             pending = None if state.completed else self._tick()
+            self.flush_outboxes()
             self._record(state, output, cycle_time_s)
             self.cycles += 1
             if self.cycles % SNAPSHOT_EVERY == 0:
@@ -295,7 +317,8 @@ class GroundStation:
 
     def _tick(self) -> PendingStep | None:
         """Start the next step (None once the scenario's timeout is reached): in lockstep,
-        advance the clock and send every vehicle the tick; in real time the step just runs."""
+        advance the clock and queue every vehicle's tick after its commands; in real time the
+        step just runs."""
         step = self.scenario.control.t_cont_s
         if self.sim_time_s >= self.scenario.run.timeout_s - 1e-9:
             return None
@@ -305,7 +328,7 @@ class GroundStation:
         self.sim_time_s = target_ms / 1000.0
         tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
         for view in self.views.values():
-            self.send(tick, view)
+            self.queue_for(tick, view)
         return PendingStep(step, tick)
 
     def _await_step(self, pending: PendingStep) -> None:
@@ -327,9 +350,11 @@ class GroundStation:
             behind = [v for v in awaited if v.step_ms < target_ms]
             if not behind or time.monotonic() >= deadline:
                 break
-            for view in behind:  # the tick or the step's telemetry was lost: ask again
-                self.send(tick, view)
+            for view in behind:  # the batch or the step's telemetry was lost: send it again
+                for message in view.last_batch:  # encoded afresh: a signed link refuses replays
+                    self.queue_for(message, view)
                 self.link_stats["tick_resends"] += 1
+            self.flush_outboxes()
         stragglers = [v for v in self.views.values() if v.step_ms < target_ms and not v.lost]
         if stragglers:
             self.pump(
@@ -386,21 +411,21 @@ class GroundStation:
             self._estimate(state.yhat[name], self.views[name])
             self._setpoint(target, self.views[name])
         if output.arrived is not None and not state.completed:
-            self.send(
+            self.queue_for(
                 mavlink2.MAVLink_mission_set_current_message(work.system_id, 1, state.k + 1), work
             )
             self._announce(f"Work UAV reached waypoint {output.arrived + 1}")
 
     def _estimate(self, position: np.ndarray, view: VehicleView) -> None:
         n, e, d = (float(v) for v in enu_to_ned(position))
-        self.send(
+        self.queue_for(
             mavlink2.MAVLink_vision_position_estimate_message(self.time_usec, n, e, d, 0, 0, 0),
             view,
         )
 
     def _setpoint(self, target: np.ndarray, view: VehicleView) -> None:
         n, e, d = (float(v) for v in enu_to_ned(target))
-        self.send(
+        self.queue_for(
             mavlink2.MAVLink_set_position_target_local_ned_message(
                 round(self.sim_time_s * 1000),
                 view.system_id,

@@ -7,6 +7,7 @@ import select
 import socket
 import time
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -178,27 +179,29 @@ class UdpEndpoint:
                 self.counters.packets_out += 1
         return packet
 
-    def send_many(self, messages: list[Any], destinations: list[Address]) -> list[bytes]:
-        """Encode several messages and send them packed into as few datagrams as fit.
+    def encode(self, message: Any) -> bytes:
+        """Pack a message as this endpoint's identity, to send later with
+        :meth:`send_packets`."""
+        return self.codec.encode(message)
+
+    def send_packets(
+        self, packets: Sequence[bytes], destinations: Sequence[Address]
+    ) -> list[bytes]:
+        """Send encoded packets packed into as few datagrams as fit; return the datagrams.
 
         MAVLink over UDP is a byte stream cut into datagrams: receivers (pymavlink, MAVProxy,
-        QGroundControl, this project) parse every packet in a datagram.
+        QGroundControl, this project) parse every packet in a datagram, in order.
         """
-        datagrams: list[bytes] = []
-        current = bytearray()
-        for message in messages:
-            packet = self.codec.encode(message)
-            if current and len(current) + len(packet) > MAX_BATCH_BYTES:
-                datagrams.append(bytes(current))
-                current = bytearray()
-            current += packet
-        if current:
-            datagrams.append(bytes(current))
+        datagrams = pack_datagrams(packets)
         self.resend(datagrams, destinations)
-        self.counters.packets_out += len(messages) * len(destinations)
+        self.counters.packets_out += len(packets) * len(destinations)
         return datagrams
 
-    def resend(self, datagrams: list[bytes], destinations: list[Address]) -> None:
+    def send_many(self, messages: list[Any], destinations: Sequence[Address]) -> list[bytes]:
+        """Encode several messages and send them packed into as few datagrams as fit."""
+        return self.send_packets([self.codec.encode(m) for m in messages], destinations)
+
+    def resend(self, datagrams: Sequence[bytes], destinations: Sequence[Address]) -> None:
         """Send already-encoded datagrams (e.g. a step's telemetry asked for again)."""
         for destination in destinations:
             for datagram in datagrams:
@@ -216,6 +219,20 @@ class UdpEndpoint:
         if self.link is not None:
             self.link.close()
         self.sock.close()
+
+
+def pack_datagrams(packets: Sequence[bytes]) -> list[bytes]:
+    """Packets joined into datagrams of at most MAX_BATCH_BYTES (a longer packet alone)."""
+    datagrams: list[bytes] = []
+    current = bytearray()
+    for packet in packets:
+        if current and len(current) + len(packet) > MAX_BATCH_BYTES:
+            datagrams.append(bytes(current))
+            current = bytearray()
+        current += packet
+    if current:
+        datagrams.append(bytes(current))
+    return datagrams
 
 
 def parse_address(text: str, what: str = "address") -> Address:

@@ -224,3 +224,71 @@ def test_sim_state_never_reaches_the_estimator(along, tmp_path):
     np.testing.assert_array_equal(xhat_a, xhat_b)
     for name in supports_a:
         np.testing.assert_array_equal(supports_a[name], supports_b[name])
+
+
+def test_a_vehicles_commands_and_tick_leave_in_one_datagram_and_are_resent_together(
+    along, tmp_path
+):
+    """Estimate, setpoint and tick reach a vehicle as one datagram, in that order, each packet
+    logged at its own time; a vehicle that stays behind gets the whole batch again, encoded
+    afresh (new sequence numbers, so a signed link would not refuse it as a replay)."""
+    import socket
+
+    from ground_station.station import GroundStation, StationConfig
+    from mission.mavlink_udp import MavlinkCodec
+
+    names = ("work", "support-1", "support-2", "support-3")
+    sockets = {}
+    for name in names:
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        sock.bind(("127.0.0.1", 0))
+        sock.settimeout(2.0)
+        sockets[name] = sock
+    config = StationConfig(
+        True,
+        {n: sockets[n].getsockname() for n in names},
+        Path(along.task.waypoints_dir),
+        tmp_path,
+        step_timeout_wall_s=0.1,
+        late_grace_wall_s=0.01,
+    )
+    station = GroundStation(World(along), config)
+    try:
+        station.sim_time_s = 2.0
+        for name in names:
+            station._estimate(np.array([1.0, 2.0, 3.0]), station.views[name])
+            station._setpoint(np.array([4.0, 5.0, 6.0]), station.views[name])
+        pending = station._tick()
+        station.flush_outboxes()
+        station._await_step(pending)  # nobody answers: the batch goes out again
+        resends = station.link_stats["tick_resends"]
+        station.tlog.flush()
+    finally:
+        station.close()
+    assert resends >= 4  # at least once to each vehicle
+    parser = MavlinkCodec(99, 1)
+    expected = ["VISION_POSITION_ESTIMATE", "SET_POSITION_TARGET_LOCAL_NED", "SYSTEM_TIME"]
+    for name, sock in sockets.items():
+        sock.settimeout(0.2)
+        batches = []
+        with contextlib.suppress(TimeoutError):
+            while True:
+                messages, bad = parser.decode(sock.recvfrom(65535)[0])
+                assert bad == 0
+                batches.append(messages)
+        sock.close()
+        assert len(batches) >= 2, name
+        for messages in batches:
+            assert [m.get_type() for m in messages] == expected, name
+            assert messages[2].time_boot_ms == 2500
+            np.testing.assert_allclose([messages[1].x, messages[1].y, messages[1].z], [5, 4, -6])
+        seqs = [m.get_seq() for messages in batches for m in messages]
+        assert len(set(seqs)) == len(seqs), "every resent packet is encoded afresh"
+    # the tlog has one record a packet: commands at the cycle's time, the tick at the next
+    log = mavutil.mavlink_connection(str(tmp_path / "gcs.tlog"), dialect="ardupilotmega")
+    first = [log.recv_match() for _ in range(12)]
+    epoch = along.run.epoch_unix_s
+    assert [m.get_type() for m in first[:8]] == expected[:2] * 4
+    assert all(m._timestamp == pytest.approx(epoch + 2.0) for m in first[:8])
+    assert [m.get_type() for m in first[8:]] == ["SYSTEM_TIME"] * 4
+    assert all(m._timestamp == pytest.approx(epoch + 2.5) for m in first[8:])

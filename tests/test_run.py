@@ -198,10 +198,11 @@ def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_p
     assert summary["completed"] is True
     link = summary["link"]
     assert (link["loss"], link["delay_ms"]) == (0.2, 50.0)
-    # the ground station drops a fifth of what it sends (binomial: +-4 sd over ~800 datagrams);
-    # lost ticks and steps are asked again
-    assert link["sent_out"] > 10 * summary["control_cycles"]
-    assert link["dropped_out"] / link["sent_out"] == pytest.approx(0.2, abs=0.06)
+    # the ground station drops a fifth of what it sends (binomial: +-4 sd over ~450 datagrams:
+    # each vehicle's commands and tick leave in one datagram a cycle); lost batches and steps
+    # are asked again
+    assert link["sent_out"] >= 4 * summary["control_cycles"]
+    assert link["dropped_out"] / link["sent_out"] == pytest.approx(0.2, abs=0.075)
     assert link["tick_resends"] > 0
     assert _children_of(scenario) == []
 
