@@ -205,6 +205,23 @@ def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_p
     assert link["dropped_out"] / link["sent_out"] == pytest.approx(0.2, abs=0.075)
     assert link["tick_resends"] > 0
     assert _children_of(scenario) == []
+    # Every lost batch or step was asked again in time, so the run is the lossless run exactly.
+    clean = _run(scenario, tmp_path / "clean")
+    assert clean.returncode == 0, clean.stderr
+    lossless = json.loads((tmp_path / "clean" / "summary.json").read_text())
+    assert link["late_steps"] == 0
+    assert _steady(summary) | {"link": None} == _steady(lossless) | {"link": None}
+    assert _records(out) == _records(tmp_path / "clean")
+
+
+def _records(out: Path) -> list[dict]:
+    """The ground station's records without their wall-clock figures."""
+    records = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
+    for record in records:
+        del record["cycle_ms"]
+        for solve in record["mpc"].values():
+            del solve["ms"]
+    return records
 
 
 def test_an_observer_sees_every_vehicle_without_disturbing_the_run(scenario, tmp_path):
