@@ -88,3 +88,57 @@ def test_a_waiting_vehicle_answers_a_new_peer_at_once():
         second.close()
     assert answer is not None
     assert waited < 0.3
+
+
+def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout():
+    """In lockstep a support publishes a step once the work UAV's truth of that step is there:
+    late truth is waited for; missing truth, for ``vehicle.truth_timeout_wall_s`` (2 s), after
+    which the camera sees the last known position (counted as a stale truth)."""
+    import numpy as np
+
+    from mission.scenario import load_scenario
+    from vehicle_sim.truth_link import TruthSender
+
+    timeout = load_scenario("along").vehicle.truth_timeout_wall_s
+    assert timeout == 2.0
+    with vehicle_process("support-1") as support:
+        assert support.truth_port is not None
+        truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
+        client = MavClient(support.address)
+        work = np.array([0.0, -4.0, 7.0])
+        truth.publish(work, 500)
+        on_time = _step_marker_after(client, 500)
+        assert on_time < 0.5 * timeout
+        client.send(mavlink2_tick(1000))
+        time.sleep(0.3)
+        truth.publish(work, 1000)  # late, but within the timeout
+        late = _wait_marker(client, 1000, time.monotonic() - 0.3)
+        assert 0.3 <= late < 0.3 + 0.5 * timeout
+        missing = _step_marker_after(client, 1500)  # no truth at all
+        assert timeout <= missing < timeout + 1.0
+        targets = [m for m in client.seen if m.get_type() == "LANDING_TARGET"]
+        assert len(targets) == 3 and all(t.position_valid for t in targets)
+        truth.close()
+        client.close()
+        report = support.stop()
+    assert "truth waits timed out 1, stale truth 1" in report
+
+
+def mavlink2_tick(time_ms: int):
+    """The ground station's lockstep tick to ``time_ms``."""
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+    return mavlink2.MAVLink_system_time_message(0, time_ms)
+
+
+def _step_marker_after(client: MavClient, time_ms: int) -> float:
+    """Tick to ``time_ms``; seconds until the vehicle's step marker for it arrives."""
+    sent = time.monotonic()
+    client.send(mavlink2_tick(time_ms))
+    return _wait_marker(client, time_ms, sent)
+
+
+def _wait_marker(client: MavClient, time_ms: int, since: float) -> float:
+    marker = client.wait_for("SYSTEM_TIME", 5.0, lambda m: m.time_boot_ms == time_ms)
+    assert marker is not None, f"no step marker for {time_ms} ms"
+    return time.monotonic() - since
