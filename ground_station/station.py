@@ -90,8 +90,7 @@ class VehicleView:
     heard_s: float = 0.0  # simulated time of the last message from it
     lost: bool = False  # silent for link_loss_s: out of fusion and the MPCs
     late: bool = False  # missed the last lockstep marker: not waited for
-    outbox: list[bytes] = field(default_factory=list)  # the cycle's packets, not yet sent
-    queued: list[Any] = field(default_factory=list)  # their messages
+    outbox: list[tuple[Any, bytes]] = field(default_factory=list)  # (message, packet) unsent
     last_batch: list[Any] = field(default_factory=list)  # the messages last sent together
 
 
@@ -144,17 +143,16 @@ class GroundStation:
         vehicle's other packets of the cycle at :meth:`flush_outboxes`."""
         packet = self.endpoint.encode(message)
         self.tlog.write(self.time_usec, packet)
-        view.outbox.append(packet)
-        view.queued.append(message)
+        view.outbox.append((message, packet))
 
     def flush_outboxes(self) -> None:
         """Each vehicle's queued packets out, in order, in one datagram (commands and tick
         wake a vehicle once, not three times)."""
         for view in self.views.values():
             if view.outbox:
-                self.endpoint.send_packets(view.outbox, [view.address])
-                view.last_batch = view.queued
-                view.outbox, view.queued = [], []
+                self.endpoint.send_packets([packet for _, packet in view.outbox], [view.address])
+                view.last_batch = [message for message, _ in view.outbox]
+                view.outbox = []
 
     def _log_received(self, message: Any, sender: Address) -> None:
         view = self.by_system.get(message.get_srcSystem())

@@ -86,9 +86,9 @@ def compiled_nlp(solver: ca.Function, fallback_dir: Callable[[], str]) -> str | 
         with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
             solver.generate_dependencies("support_mpc_nlp.c")
         source = Path(scratch) / "support_mpc_nlp.c"
-        for directory in (_cache_dir(), None):
+        for directory_of in (_cache_dir, lambda: Path(fallback_dir())):
             try:
-                directory = Path(fallback_dir()) if directory is None else directory
+                directory = directory_of()
                 directory.mkdir(parents=True, exist_ok=True)
                 library = directory / name
                 partial = directory / f".{name}.{os.getpid()}.part"
