@@ -64,8 +64,9 @@ class MeasuredValues:
 def measurements_from_values(
     values: Sequence[MeasuredValues], world: World
 ) -> list[SupportMeasurement]:
-    """Covariances evaluated at the measured values (MODEL.md 3.2.1), the GNSS geometry of
-    every fix in one batch (the same numbers as one at a time).
+    """Covariances evaluated at the measured values (MODEL.md 3.2.1): the GNSS geometry of
+    every fix in one batch and the camera's Sigma_r of every observation in another (the same
+    numbers as one at a time, tested).
 
     Where the model sees no fix at p_n but the receiver has one, the receiver's reported
     accuracy stands in for Sigma_GNSS.
@@ -76,10 +77,16 @@ def measurements_from_values(
         has_fix, sigma = world.gnss.sigma_gnss(np.array([v.fix for v in with_fix]))
         for i, v in enumerate(with_fix):
             sigma_of[v.name] = sigma[i] if has_fix[i] else v.reported
+    observed = [v for v in values if v.relative is not None]
+    sigma_relative_of: dict[str, np.ndarray] = {}
+    if observed:
+        covariances = world.camera.covariance(np.array([v.relative for v in observed]))
+        sigma_relative_of = {v.name: covariances[i] for i, v in enumerate(observed)}
     measurements = []
     for v in values:
         sigma_gnss = sigma_of.get(v.name)
         fix = v.fix if sigma_gnss is not None else None
-        sigma_relative = world.camera.covariance(v.relative) if v.relative is not None else None
-        measurements.append(SupportMeasurement(v.name, fix, sigma_gnss, v.relative, sigma_relative))
+        measurements.append(
+            SupportMeasurement(v.name, fix, sigma_gnss, v.relative, sigma_relative_of.get(v.name))
+        )
     return measurements

@@ -17,6 +17,8 @@ from mission.structure import Structure
 
 _CHUNK = 20_000
 _MIN_EIGENVALUE = 1e-9
+_MAX_REMEMBERED_MASKS = 4096  # visibility masks whose fix geometry a model keeps
+_MEMO_MAX_POINTS = 16  # larger batches (maps) are computed directly
 
 
 @dataclass(frozen=True)
@@ -59,6 +61,8 @@ class GnssModel:
         self._rows = _geometry_rows(
             self._directions, sky.constellation_index(), len(sky.constellations)
         )
+        self._fix_geometry_by_mask: dict[bytes, tuple[np.ndarray | None, np.ndarray | None]] = {}
+        self._geometry_by_mask: dict[bytes, tuple[bool, np.ndarray]] = {}
 
     def visibility(self, points: np.ndarray) -> np.ndarray:
         """(N, S) True where the satellite is above the mask and its ray misses the structure."""
@@ -88,11 +92,35 @@ class GnssModel:
         )
 
     def geometry_from_visibility(self, visible: np.ndarray) -> GnssGeometry:
-        """cov_geom for given visibility masks (N, S), without ray casting."""
-        has_fix, cov = _covariance_from_visibility(
+        """cov_geom for given visibility masks (N, S), without ray casting.
+
+        A few points at a time (a cycle's fixes) are looked up by mask, computed once per mask
+        (a row's numbers do not depend on the rows computed with it); maps go straight through.
+        """
+        visible = np.asarray(visible, dtype=bool)
+        if len(visible) > _MEMO_MAX_POINTS:
+            has_fix, cov = self._covariance(visible)
+            return GnssGeometry(visible=visible, has_fix=has_fix, cov_geom=cov)
+        keys = [row.tobytes() for row in visible]
+        if len(self._geometry_by_mask) + len(keys) > _MAX_REMEMBERED_MASKS:
+            self._geometry_by_mask.clear()
+        missing = {k: i for i, k in enumerate(keys) if k not in self._geometry_by_mask}
+        if missing:
+            rows = list(missing.values())
+            has_fix, cov = self._covariance(visible[rows])
+            for j, key in enumerate(missing):
+                self._geometry_by_mask[key] = (bool(has_fix[j]), cov[j])
+        known = [self._geometry_by_mask[k] for k in keys]
+        return GnssGeometry(
+            visible=visible,
+            has_fix=np.array([fix for fix, _ in known], dtype=bool),
+            cov_geom=np.array([cov for _, cov in known]).reshape(len(keys), 3, 3),
+        )
+
+    def _covariance(self, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _covariance_from_visibility(
             visible, self._rows, self.sky.constellation_index(), len(self.sky.constellations)
         )
-        return GnssGeometry(visible=visible, has_fix=has_fix, cov_geom=cov)
 
     def _geometry_chunk(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         geometry = self.geometry_from_visibility(self.visibility(points))
@@ -114,10 +142,7 @@ class GnssModel:
         point = np.asarray(point, dtype=float).reshape(3)
         visible = self.visibility(point[None])[0]
         n_visible = int(visible.sum())
-        cov_geom = _single_point_cov_geom(
-            self._rows[visible], self.sky.constellation_index()[visible]
-        )
-        factor = _cholesky_or_none(cov_geom) if cov_geom is not None else None
+        cov_geom, factor = self._fix_geometry(visible)
         if cov_geom is None or factor is None:
             return GnssFix(False, None, None, n_visible, None, None)
         covariance = self.settings.sigma_uere_m**2 * cov_geom
@@ -132,6 +157,21 @@ class GnssModel:
             hdop,
             float(np.sqrt(cov_geom[2, 2])),
         )
+
+    def _fix_geometry(self, visible: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """cov_geom and its Cholesky factor for a visibility mask (None without a fix),
+        remembered per mask: a vehicle sees the same few sets of satellites step after step."""
+        key = visible.tobytes()
+        known = self._fix_geometry_by_mask.get(key)
+        if known is None:
+            cov_geom = _single_point_cov_geom(
+                self._rows[visible], self.sky.constellation_index()[visible]
+            )
+            factor = _cholesky_or_none(cov_geom) if cov_geom is not None else None
+            if len(self._fix_geometry_by_mask) >= _MAX_REMEMBERED_MASKS:
+                self._fix_geometry_by_mask.clear()
+            known = self._fix_geometry_by_mask[key] = (cov_geom, factor)
+        return known
 
 
 @dataclass(frozen=True)

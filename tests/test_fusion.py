@@ -156,3 +156,34 @@ def test_blind_and_fallback():
     ]
     result = selective_fusion(far, np.zeros(3), settings, rng)
     assert result.fallback and set(result.consistent) == {"a", "b", "c"}
+
+
+def test_a_cycles_covariances_in_one_batch_equal_one_at_a_time(along_world, plan):
+    """measurements_from_values batches Sigma_GNSS and Sigma_r over the supports: the numbers
+    are those of each support alone, bit for bit (with a support lacking an observation and
+    one lacking a fix among them)."""
+    from ground_station.measurements import MeasuredValues, measurements_from_values
+
+    rng = np.random.default_rng(2)
+    for i in range(0, len(plan.work), 3):
+        values = []
+        for n, y in enumerate(plan.supports[:, i]):
+            fix = along_world.gnss.sample_fix(y, rng).position_m
+            relative = plan.work[i] - y + rng.normal(0, 0.05, 3)
+            values.append(
+                MeasuredValues(
+                    f"support-{n + 1}",
+                    None if n == 2 else fix,
+                    None if n == 1 else relative,
+                    np.eye(3) * 0.01,
+                )
+            )
+        together = measurements_from_values(values, along_world)
+        for value, joint in zip(values, together):
+            (alone,) = measurements_from_values([value], along_world)
+            for field in ("fix_m", "sigma_gnss_m2", "relative_m", "sigma_relative_m2"):
+                a, b = getattr(alone, field), getattr(joint, field)
+                assert (a is None) == (b is None), field
+                if a is not None:
+                    assert np.array_equal(a, b), field
+        assert together[0].contributes and not together[1].contributes

@@ -131,3 +131,58 @@ def test_sigma0_map_open_sky_and_capped_under_the_deck(along_world):
     assert sigma0.sigma_m[under_index] == along_world.scenario.map.no_fix_sigma_m
     assert not sigma0.has_fix[under_index]
     assert np.all(sigma0.sigma_m <= along_world.scenario.map.no_fix_sigma_m)
+
+
+def _points_around_the_bridge(n: int, seed: int = 3) -> np.ndarray:
+    """Open sky, beside the piers and under the deck (every kind of visibility mask)."""
+    rng = np.random.default_rng(seed)
+    return np.column_stack(
+        [rng.uniform(-30, 30, n), rng.uniform(-20, 20, n), rng.uniform(0.5, 12, n)]
+    )
+
+
+def test_fixes_are_the_same_with_remembered_geometry(along_world, monkeypatch):
+    """Fix geometry remembered per visibility mask (and the memory emptied when full) gives
+    the fixes that computing it afresh for every fix gives, bit for bit."""
+    from mission import gnss
+
+    points = _points_around_the_bridge(300)
+    fresh = World(along_world.scenario).gnss
+    remembered = World(along_world.scenario).gnss
+    monkeypatch.setattr(gnss, "_MAX_REMEMBERED_MASKS", 5)  # exercise the emptying too
+
+    def afresh(model, visible):
+        cov = gnss._single_point_cov_geom(
+            model._rows[visible], model.sky.constellation_index()[visible]
+        )
+        return cov, gnss._cholesky_or_none(cov) if cov is not None else None
+
+    monkeypatch.setattr(fresh, "_fix_geometry", lambda visible: afresh(fresh, visible))
+    rng_a, rng_b = np.random.default_rng(9), np.random.default_rng(9)
+    with_fix = 0
+    for point in np.vstack([points, points]):  # the second pass finds masks remembered
+        a, b = fresh.sample_fix(point, rng_a), remembered.sample_fix(point, rng_b)
+        assert (a.has_fix, a.n_visible, a.hdop, a.vdop) == (b.has_fix, b.n_visible, b.hdop, b.vdop)
+        if a.has_fix:
+            with_fix += 1
+            assert np.array_equal(a.position_m, b.position_m)
+            assert np.array_equal(a.covariance_m2, b.covariance_m2)
+    assert 0 < with_fix < 600  # both kinds of point were drawn
+    assert 0 < len(remembered._fix_geometry_by_mask) <= 5
+
+
+def test_a_few_points_geometry_equals_the_batched_computation(along_world, monkeypatch):
+    """Sigma_GNSS of a cycle's few fixes, looked up per mask, equals the batched computation
+    over all points at once (a row does not depend on the rows beside it)."""
+    from mission import gnss
+
+    points = _points_around_the_bridge(240, seed=4)
+    model = World(along_world.scenario).gnss
+    monkeypatch.setattr(gnss, "_MAX_REMEMBERED_MASKS", 7)
+    assert len(points) > gnss._MEMO_MAX_POINTS  # so this call is the direct one
+    has_fix_all, sigma_all = model.sigma_gnss(points)
+    for start in range(0, len(points), 3):
+        has_fix, sigma = model.sigma_gnss(points[start : start + 3])
+        assert np.array_equal(has_fix, has_fix_all[start : start + 3])
+        assert np.array_equal(sigma, sigma_all[start : start + 3], equal_nan=True)
+    assert 0 < has_fix_all.sum() < len(points)
