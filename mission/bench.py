@@ -26,7 +26,7 @@ class BenchResult:
     value: float
     unit: str
     target: str
-    ok: bool
+    ok: bool | None  # None: a reference figure with no target
 
 
 def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
@@ -289,9 +289,20 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
 }
 
 
+def bench_machine_speed(repeats: int = 5) -> BenchResult:
+    """CPU seconds of a fixed pure-Python loop: how fast this machine is right now (a shared
+    VM's speed drifts by tens of per cent within hours, and every other row moves with it)."""
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        sum(range(10_000_000))
+        times.append(time.process_time() - start)
+    return BenchResult("machine_python_loop_s", statistics.median(times), "s", "reference", None)
+
+
 def run_benchmarks(only: list[str] | None = None) -> list[BenchResult]:
-    """Run the chosen benchmark groups (all by default)."""
-    results: list[BenchResult] = []
+    """Run the chosen benchmark groups (all by default), after the machine's speed."""
+    results: list[BenchResult] = [bench_machine_speed()]
     for name, bench in BENCHMARKS.items():
         if only is None or name in only:
             results.extend(bench())
@@ -302,7 +313,11 @@ def format_table(results: list[BenchResult]) -> str:
     """A plain-text table of results."""
     lines = [f"{'benchmark':<32} {'value':>12} {'unit':<8} {'target':<10} ok"]
     lines += [
-        f"{r.name:<32} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {'yes' if r.ok else 'NO'}"
+        f"{r.name:<32} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {_verdict(r.ok)}"
         for r in results
     ]
     return "\n".join(lines)
+
+
+def _verdict(ok: bool | None) -> str:
+    return "-" if ok is None else "yes" if ok else "NO"

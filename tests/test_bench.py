@@ -83,3 +83,15 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     ]
     assert rows["table3_wall_s_estimate"].value == pytest.approx(15 * 44.0 / 2)
     assert rows["table3_wall_s_estimate"].ok  # 330 s <= 600 s
+
+
+def test_every_invocation_starts_with_the_machines_speed_without_a_verdict(monkeypatch):
+    monkeypatch.setattr(
+        bench, "BENCHMARKS", {"world": lambda: [bench.BenchResult("x", 1.0, "s", "<= 2", True)]}
+    )
+    rows = bench.run_benchmarks(["world"])
+    assert [r.name for r in rows] == ["machine_python_loop_s", "x"]
+    assert rows[0].ok is None and 0 < rows[0].value < 60
+    table = bench.format_table(rows).splitlines()
+    assert table[1].split()[-2:] == ["reference", "-"]
+    assert table[2].split()[-1] == "yes"
