@@ -53,7 +53,7 @@ class FusionResult:
     contributing: tuple[str, ...]
     fallback: bool
     rho: np.ndarray
-    gaussians: tuple[tuple[np.ndarray, np.ndarray], ...]
+    densities: tuple[LogDensity, ...]  # log f(x; mu_n, Sigma_n) of the supports in S
 
     @property
     def blind(self) -> bool:
@@ -63,17 +63,35 @@ class FusionResult:
     def log_p(self, x: np.ndarray) -> np.ndarray:
         """log P(x) up to the constant alpha: sum over S of log f(x; mu_n, Sigma_n)."""
         return sum(
-            (log_gaussian(np.atleast_2d(x), mu, sigma) for mu, sigma in self.gaussians),
+            (density(np.atleast_2d(x)) for density in self.densities),
             start=np.zeros(len(np.atleast_2d(x))),
         )
 
 
+@dataclass(frozen=True)
+class LogDensity:
+    """log N(x; mu, sigma) with sigma's Cholesky factor and log-determinant computed once (a
+    cycle evaluates each support's density several times)."""
+
+    mu: np.ndarray
+    factor: np.ndarray
+    log_det: float
+
+    @classmethod
+    def of(cls, mu: np.ndarray, sigma: np.ndarray) -> LogDensity:
+        """The density of N(mu, sigma)."""
+        factor = np.linalg.cholesky(sigma)
+        return cls(mu, factor, 2.0 * np.sum(np.log(np.diag(factor))))
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """log N(x; mu, sigma) for rows of x."""
+        z = np.linalg.solve(self.factor, (x - self.mu).T)
+        return -0.5 * (np.sum(z * z, axis=0) + self.log_det + 3 * np.log(2 * np.pi))
+
+
 def log_gaussian(x: np.ndarray, mu: np.ndarray, sigma: np.ndarray) -> np.ndarray:
     """log N(x; mu, sigma) for rows of x."""
-    factor = np.linalg.cholesky(sigma)
-    z = np.linalg.solve(factor, (x - mu).T)
-    log_det = 2.0 * np.sum(np.log(np.diag(factor)))
-    return -0.5 * (np.sum(z * z, axis=0) + log_det + 3 * np.log(2 * np.pi))
+    return LogDensity.of(mu, sigma)(x)
 
 
 def selective_fusion(
@@ -92,17 +110,19 @@ def selective_fusion(
         rng.multivariate_normal(s.mu, s.sigma, settings.local_particles, method="cholesky")
         for s in contributing
     ]
-    rho = correlation_matrix([log_gaussian(broad, s.mu, s.sigma) for s in contributing])
+    densities = [LogDensity.of(s.mu, s.sigma) for s in contributing]
+    rho = correlation_matrix([density(broad) for density in densities])
     agree = (rho > settings.rho_threshold).sum(axis=1)
-    chosen = [s for s, count in zip(contributing, agree) if count >= len(contributing) / 2]
-    fallback = not chosen
+    in_s = [i for i, count in enumerate(agree) if count >= len(contributing) / 2]
+    fallback = not in_s
     if fallback:
-        chosen = contributing
+        in_s = list(range(len(contributing)))
     particles = np.vstack([broad, *local])
-    gaussians = tuple((s.mu, s.sigma) for s in chosen)
-    score = sum(log_gaussian(particles, mu, sigma) for mu, sigma in gaussians)
+    chosen = tuple(densities[i] for i in in_s)
+    score = sum(density(particles) for density in chosen)
     xhat = particles[int(np.argmax(score))]
-    return FusionResult(xhat, tuple(s.name for s in chosen), names, fallback, rho, gaussians)
+    consistent = tuple(contributing[i].name for i in in_s)
+    return FusionResult(xhat, consistent, names, fallback, rho, chosen)
 
 
 def correlation_matrix(log_densities: list[np.ndarray]) -> np.ndarray:

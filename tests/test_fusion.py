@@ -10,6 +10,7 @@ from scipy.stats import multivariate_normal, pearsonr
 
 from ground_station.fusion import (
     FusionResult,
+    LogDensity,
     SupportMeasurement,
     correlation_matrix,
     log_gaussian,
@@ -117,7 +118,7 @@ def test_feedback_matches_a_hand_computation():
         ("a", "b"),
         False,
         np.eye(2),
-        ((mu_a, sigma), (mu_b, sigma)),
+        (LogDensity.of(mu_a, sigma), LogDensity.of(mu_b, sigma)),
     )
     r = np.array([0.0, 0.0, 2.0])
     support = SupportMeasurement("a", mu_a - r, np.eye(3) * 0.01, r, np.eye(3) * 0.01)
