@@ -427,17 +427,28 @@ class SupportMpc:
         return anchors
 
     def _nearest_visible(self, start: np.ndarray, work: np.ndarray, fallback: np.ndarray):
-        for radius in (0.0, *self._shell_radii):  # the step itself first
-            points = start[None] if radius == 0 else start + radius * self._directions
-            if self.sigma0 is not None:
-                usable = hermite_zero_slope(self.sigma0, self.grid, points)
-                points = points[usable <= self.control.support_max_sigma0_m]
-            if len(points) == 0:
-                continue
-            seen = points[self.camera.observable(points, work[None])]
+        # The step itself, then shell after shell; the step and the first shell are judged in
+        # one evaluation (nine anchors in ten are found there, and a point's verdict does not
+        # depend on the points judged with it).
+        first = np.vstack([start[None], start + self._shell_radii[0] * self._directions])
+        sees = self._sees_with_a_fix(first, work)
+        if sees[0]:
+            return start
+        shells = [(first[1:], sees[1:])]
+        shells += [(start + r * self._directions, None) for r in self._shell_radii[1:]]
+        for points, verdict in shells:
+            seen = points[self._sees_with_a_fix(points, work) if verdict is None else verdict]
             if len(seen):
                 return seen[np.argmin(np.linalg.norm(seen - work, axis=1))]
         return fallback
+
+    def _sees_with_a_fix(self, points: np.ndarray, work: np.ndarray) -> np.ndarray:
+        """Where a point has a usable prior fix and sees the work UAV."""
+        usable = np.ones(len(points), dtype=bool)
+        if self.sigma0 is not None:
+            sigma = hermite_zero_slope(self.sigma0, self.grid, points)
+            usable = sigma <= self.control.support_max_sigma0_m
+        return usable & self.camera.observable(points, work[None])
 
     def _escape_guesses(self, yhat: np.ndarray, fixed: np.ndarray, flags: np.ndarray):
         """Paths leaving at d_max per step along +-x, +-y or +-z for half the horizon, then
