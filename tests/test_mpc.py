@@ -363,3 +363,34 @@ def test_supports_stay_out_of_the_structures_gnss_shadow(along_world):
         along_world, _with_control(along_world, los_penalty="paper", support_max_sigma0_m=1e9)
     )
     assert np.max(hermite_zero_slope(sigma0, grid, free.path)) > limit  # into the deck
+
+
+def test_anchors_are_the_nearest_visible_points_shell_by_shell(along_world):
+    """The anchor search (step and first shell judged together) returns what judging the step
+    and then each shell on its own returns, for blocked steps all around the bridge."""
+    mpc = _with_control(along_world, los_penalty="visible-point")
+    control, camera = mpc.control, along_world.camera
+
+    def shell_by_shell(start, work, fallback):
+        for radius in (0.0, *mpc._shell_radii):
+            points = start[None] if radius == 0 else start + radius * mpc._directions
+            usable = hermite_zero_slope(mpc.sigma0, mpc.grid, points)
+            points = points[usable <= control.support_max_sigma0_m]
+            if len(points) == 0:
+                continue
+            seen = points[camera.observable(points, work[None])]
+            if len(seen):
+                return seen[np.argmin(np.linalg.norm(seen - work, axis=1))]
+        return fallback
+
+    rng = np.random.default_rng(6)
+    work = np.array([0.0, -3.0, 7.0])  # under the deck's edge
+    fallback = np.array([99.0, 99.0, 99.0])
+    found_at = set()
+    for _ in range(150):
+        start = np.array([rng.uniform(-15, 15), rng.uniform(-12, 12), rng.uniform(1, 13)])
+        expected = shell_by_shell(start, work, fallback)
+        got = mpc._nearest_visible(start, work, fallback)
+        np.testing.assert_array_equal(got, expected)
+        found_at.add(round(float(np.linalg.norm(expected - start)), 6))
+    assert 0.0 in found_at and len(found_at) > 3  # the step itself, first and further shells
