@@ -171,18 +171,43 @@ def test_fixes_are_the_same_with_remembered_geometry(along_world, monkeypatch):
     assert 0 < len(remembered._fix_geometry_by_mask) <= 5
 
 
+def _every_row_computed(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(has_fix, cov_geom) with no memory and no grouping: the batched formula on every row."""
+    from mission import gnss
+
+    visible = model.visibility(points)
+    return gnss._covariance_from_visibility(
+        visible, model._rows, model.sky.constellation_index(), len(model.sky.constellations)
+    )
+
+
 def test_a_few_points_geometry_equals_the_batched_computation(along_world, monkeypatch):
-    """Sigma_GNSS of a cycle's few fixes, looked up per mask, equals the batched computation
-    over all points at once (a row does not depend on the rows beside it)."""
+    """Sigma_GNSS of a cycle's few fixes, looked up per mask, and of many points, grouped by
+    mask, equal the batched computation on every row (a row does not depend on the rows
+    beside it)."""
     from mission import gnss
 
     points = _points_around_the_bridge(240, seed=4)
     model = World(along_world.scenario).gnss
     monkeypatch.setattr(gnss, "_MAX_REMEMBERED_MASKS", 7)
-    assert len(points) > gnss._MEMO_MAX_POINTS  # so this call is the direct one
-    has_fix_all, sigma_all = model.sigma_gnss(points)
+    assert len(points) > gnss._MEMO_MAX_POINTS  # so this call is the grouped one
+    has_fix_all, cov_all = _every_row_computed(model, points)
+    sigma_all = along_world.scenario.gnss.sigma_uere_m**2 * cov_all
+    has_fix, sigma = model.sigma_gnss(points)
+    assert np.array_equal(has_fix, has_fix_all)
+    assert np.array_equal(sigma, sigma_all, equal_nan=True)
     for start in range(0, len(points), 3):
         has_fix, sigma = model.sigma_gnss(points[start : start + 3])
         assert np.array_equal(has_fix, has_fix_all[start : start + 3])
         assert np.array_equal(sigma, sigma_all[start : start + 3], equal_nan=True)
     assert 0 < has_fix_all.sum() < len(points)
+
+
+def test_the_map_grouped_by_mask_equals_every_voxel_computed(along_world):
+    model = World(along_world.scenario).gnss
+    centers = along_world.map_grid().centers().reshape(-1, 3)
+    geometry = model.geometry(centers)
+    has_fix, cov = _every_row_computed(model, centers)
+    assert np.array_equal(geometry.has_fix, has_fix)
+    assert np.array_equal(geometry.cov_geom, cov, equal_nan=True)
+    assert len(np.unique(geometry.visible, axis=0)) < len(centers) / 50  # few masks, many voxels
