@@ -11,7 +11,7 @@ import pytest
 import trimesh
 
 from mission.errors import ScenarioError
-from mission.scenario import embedded_scenario_names, load_scenario
+from mission.scenario import embedded_scenario_names, load_scenario, read_yaml_mapping
 from mission.world import World
 
 
@@ -22,6 +22,17 @@ def test_both_embedded_scenarios_load():
         assert scenario.name == name
         assert len(scenario.world.zones) == 1
         assert scenario.world.zones[0].offset_m == (1.0, 0.0, 0.0)
+
+
+def test_packaged_yaml_reads_the_same_as_with_pyyamls_pure_python_safe_loader():
+    import yaml
+
+    import mission
+
+    files = sorted((Path(mission.__file__).parent / "scenarios").glob("*.yaml"))
+    assert len(files) >= 3
+    for path in files:
+        assert read_yaml_mapping(path) == yaml.safe_load(path.read_text())
 
 
 def test_model_defaults_reach_the_settings(along):
@@ -112,7 +123,7 @@ BAD_INPUTS = [
         "must be in [0, 90)",
     ),
     ("unknown base", "extends: nosuch\n", "extends", "no such scenario"),
-    ("bad yaml", "map: {voxel_size_m: [1, 2\n", "line ", "invalid YAML"),
+    ("bad yaml", "map: {voxel_size_m: [1, 2\n", "line 2, column 1", "but got '<stream end>'"),
     ("not a mapping", "- 1\n- 2\n", "", "must hold a mapping"),
     ("section not mapping", "gnss: 3\n", "gnss", "expected a mapping"),
     (
