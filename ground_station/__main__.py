@@ -2,6 +2,10 @@
 
 import sys
 
-from ground_station.cli import entry_point
+from mission.math_threads import use_one_math_thread
+
+use_one_math_thread()
+
+from ground_station.cli import entry_point  # noqa: E402  (numpy loads here, after the setting)
 
 sys.exit(entry_point())

@@ -1,8 +1,9 @@
 """``python -m ground_station.mpc_helper``: a process that solves support MPCs for the ground
 station, so two cores share a cycle's solves.
 
-It reads pickled frames on stdin and answers on stdout: first the scenario (it builds its own
-world, sigma_0 map and solver, the same as the ground station's), then lists of
+It reads pickled frames on stdin and answers on stdout: first the scenario and the ground
+station's sigma_0 map (it builds its own world and solver, the same as the ground
+station's), then lists of
 :class:`~ground_station.support_mpc.PlanRequest`, each answered with the list of plans or an
 error text. A frame is a 4-byte big-endian length and a pickle; both ends are this program.
 The helper ends at end of input, i.e. when the ground station closes the pipe or dies.
@@ -44,15 +45,16 @@ def read_frame(stream: BinaryIO) -> Any:
 def serve(requests: BinaryIO, answers: BinaryIO) -> None:
     """Build the solver from the first frame, then answer request lists until end of input."""
     from ground_station.support_mpc import SupportMpc
+    from mission.cli_common import freeze_startup_heap
     from mission.world import World
 
     try:
-        scenario = read_frame(requests)
+        scenario, sigma0 = read_frame(requests)
     except EOFError:
         return
     world = World(scenario)
-    sigma0 = world.sigma0_map().sigma_m
     mpc = SupportMpc(scenario.control, world.map_grid(), world.camera, sigma0)
+    freeze_startup_heap()
     while True:
         try:
             batch = read_frame(requests)
@@ -74,4 +76,7 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    from mission.math_threads import use_one_math_thread
+
+    use_one_math_thread()  # before serve() imports numpy
     sys.exit(main())

@@ -26,6 +26,7 @@ from ground_station.support_mpc import SupportMpc
 from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
 from ground_station.tlog import TlogWriter
 from mission.atomic import write_text_atomically
+from mission.cli_common import freeze_startup_heap
 from mission.frames import GeodeticFrame, enu_to_ned
 from mission.link_impairment import LinkSettings
 from mission.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
@@ -239,12 +240,16 @@ class GroundStation:
     def run(self) -> dict[str, Any]:
         """Connect, upload, arm, then cycle until done or timeout; return a summary."""
         start_wall = time.monotonic()
-        if self.config.mpc_helper:  # it builds its solver while we connect
-            self._helper = MpcHelper(self.scenario, str(self.config.out_dir))
+        if self.config.mpc_helper:  # it imports while sigma_0 is computed here
+            self._helper = MpcHelper(str(self.config.out_dir))
+        sigma0 = self.world.sigma0_map().sigma_m
+        if self._helper is not None:  # and builds its solver while we connect
+            self._helper.set_up(self.scenario, sigma0)
         self.connect()
         waypoints = self.upload_missions()
         self.arm_all()
-        models, state = self._initial(waypoints)
+        models, state = self._initial(waypoints, sigma0)
+        freeze_startup_heap()
         supports = [n for n in self.views if n != "work"]
         self._snapshot(models.g, "initial")
         self._last_seq.clear()  # count losses from here: set-up traffic is not all logged here
@@ -307,9 +312,11 @@ class GroundStation:
         }
         write_text_atomically(self.config.out_dir / "link.json", json.dumps(stats) + "\n")
 
-    def _initial(self, waypoints: dict[str, np.ndarray]) -> tuple[Models, StationState]:
+    def _initial(
+        self, waypoints: dict[str, np.ndarray], sigma0: np.ndarray
+    ) -> tuple[Models, StationState]:
         self.models, state = build_models(
-            self.world, waypoints, self.config.adaptive, self.config.seed, self._helper
+            self.world, waypoints, self.config.adaptive, self.config.seed, self._helper, sigma0
         )
         return self.models, state
 
@@ -506,12 +513,16 @@ def build_models(
     adaptive: bool,
     seed: int,
     helper: MpcHelper | None = None,
+    sigma0: np.ndarray | None = None,
 ) -> tuple[Models, StationState]:
     """Everything the control cycle needs, and the state at the start (vehicles at w_1);
-    the support MPCs are shared with ``helper`` if one is given."""
+    the support MPCs are shared with ``helper`` if one is given. ``sigma0`` is the world's
+    sigma_0 map if already computed."""
     scn = world.scenario
     grid = world.map_grid()
-    g = LocalizabilityMap(grid, world.sigma0_map().sigma_m, scn.map, adaptive)
+    if sigma0 is None:
+        sigma0 = world.sigma0_map().sigma_m
+    g = LocalizabilityMap(grid, sigma0, scn.map, adaptive)
     supports = {n: w for n, w in waypoints.items() if n != "work"}
     mpc = SupportMpc(scn.control, grid, world.camera, g.initial)
     observable = world.camera.observable

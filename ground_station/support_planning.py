@@ -22,6 +22,8 @@ from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
 from mission.cli_common import child_environment
 from mission.settings import Scenario
 
+SET_UP_PIPE_BYTES = 1 << 20  # the set-up frame (a sigma_0 map of 40,000 voxels) is ~0.3 MB
+
 Observable = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
@@ -114,9 +116,9 @@ class MpcHelper:
     """The helper process: started early (it builds its solver while the ground station
     connects), fed request lists, stopped by closing its input."""
 
-    def __init__(self, scenario: Scenario, label: str = "") -> None:
-        """Start the helper and send it ``scenario``; ``label`` (e.g. the run's directory)
-        goes on its command line, so ``ps`` tells whose helper it is."""
+    def __init__(self, label: str = "") -> None:
+        """Start the helper; ``label`` (e.g. the run's directory) goes on its command line,
+        so ``ps`` tells whose helper it is. Its set-up follows with :meth:`set_up`."""
         self.process = subprocess.Popen(
             [
                 sys.executable,
@@ -128,7 +130,17 @@ class MpcHelper:
             stdout=subprocess.PIPE,
             env=child_environment(),
         )
-        self.send(scenario)
+        assert self.process.stdin is not None
+        with contextlib.suppress(ImportError, OSError, AttributeError):  # else writes may wait
+            import fcntl
+
+            fcntl.fcntl(self.process.stdin.fileno(), fcntl.F_SETPIPE_SZ, SET_UP_PIPE_BYTES)
+
+    def set_up(self, scenario: Scenario, sigma0_m: np.ndarray) -> None:
+        """Send the scenario and the sigma_0 map, so the helper builds the same solver as
+        this process without computing the map again. The pipe is widened to hold them, so
+        this returns at once while the helper is still importing."""
+        self.send((scenario, np.asarray(sigma0_m, dtype=float)))
 
     def send(self, value) -> None:
         """One frame to the helper (BrokenPipeError if it is gone)."""

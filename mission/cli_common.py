@@ -51,6 +51,16 @@ def child_environment() -> dict[str, str]:
     return {**os.environ, PARENT_PID_VARIABLE: str(os.getpid())}
 
 
+def freeze_startup_heap() -> None:
+    """Exempt everything allocated so far (modules, world, solver) from garbage collection.
+
+    A long-running process calls this once it is set up: full collections then skip the
+    ~10^5 objects of numpy, pymavlink and casadi, and so does the exit (40 ms -> 10 ms)."""
+    import gc
+
+    gc.freeze()
+
+
 def die_with_parent() -> None:
     """Ask Linux to send SIGTERM when the parent process dies (no orphans); no-op elsewhere."""
     import contextlib

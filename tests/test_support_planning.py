@@ -59,7 +59,8 @@ def _same(a: SupportPlan, b: SupportPlan) -> bool:
 
 
 def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along_world, local):
-    helper = MpcHelper(along_world.scenario)
+    helper = MpcHelper()
+    helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
     shared = HelperPlanner(local.mpc, local.observable, helper)
     try:
         for index in (2, 6, 9):
@@ -74,8 +75,32 @@ def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along
     assert helper.process.returncode == 0
 
 
+@pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="needs /proc")
+def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, monkeypatch):
+    import os
+
+    def threads_after_a_plan() -> int:
+        helper = MpcHelper()
+        helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
+        shared = HelperPlanner(local.mpc, local.observable, helper)
+        try:
+            shared.plan_all(_requests(along_world, local.mpc, 2))  # numpy and casadi loaded
+            return len(os.listdir(f"/proc/{helper.process.pid}/task"))
+        finally:
+            shared.close()
+
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    unset = threads_after_a_plan()
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "1")
+    assert unset == threads_after_a_plan()  # (Embree may have a worker of its own)
+    if (os.cpu_count() or 1) >= 2:
+        monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
+        assert threads_after_a_plan() > unset  # numpy's and casadi's OpenBLAS add workers
+
+
 def test_a_dead_helpers_share_is_solved_here(along_world, local, capfd):
-    helper = MpcHelper(along_world.scenario)
+    helper = MpcHelper()
+    helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
     shared = HelperPlanner(local.mpc, local.observable, helper)
     requests = _requests(along_world, local.mpc, 4)
     shared.plan_all(requests)  # the helper answered once

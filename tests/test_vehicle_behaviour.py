@@ -231,3 +231,27 @@ def test_geofence_refuses_setpoints_and_the_vehicle_holds(frame, target, reason)
     assert f"Setpoint rejected: fence: {reason}" in texts, texts
     assert np.linalg.norm(held - moving) < QUANTUM_M, "stops where it was told to leave the fence"
     assert np.linalg.norm(after - held) == pytest.approx(0.5, abs=QUANTUM_M)
+
+
+def _threads(pid: int) -> int:
+    from pathlib import Path
+
+    return len(list(Path(f"/proc/{pid}/task").iterdir()))
+
+
+@pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="needs /proc")
+def test_a_vehicle_asks_blas_for_one_thread_unless_told(monkeypatch):
+    import os
+
+    def threads(setting: str | None) -> int:
+        if setting is None:
+            monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+        else:
+            monkeypatch.setenv("OPENBLAS_NUM_THREADS", setting)
+        with vehicle_process("support-1") as vehicle:
+            return _threads(vehicle.process.pid)
+
+    unset = threads(None)
+    assert unset == threads("1")  # OpenBLAS would start one worker per core
+    if (os.cpu_count() or 1) >= 2:
+        assert threads("2") == unset + 1

@@ -12,6 +12,7 @@ import numpy as np
 from mission.cli_common import (
     OneLineArgumentParser,
     add_link_arguments,
+    freeze_startup_heap,
     link_settings,
     parse_point,
     run_guarded,
@@ -164,6 +165,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         file=sys.stderr,
         flush=True,
     )
+    freeze_startup_heap()
     try:
         server.run()
     finally:
