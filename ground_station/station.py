@@ -313,7 +313,7 @@ class GroundStation:
         write_text_atomically(self.config.out_dir / "link.json", json.dumps(stats) + "\n")
 
     def _initial(
-        self, waypoints: dict[str, np.ndarray], sigma0: np.ndarray
+        self, waypoints: dict[str, np.ndarray], sigma0: np.ndarray | None = None
     ) -> tuple[Models, StationState]:
         self.models, state = build_models(
             self.world, waypoints, self.config.adaptive, self.config.seed, self._helper, sigma0
