@@ -244,7 +244,12 @@ class GroundStation:
             self._helper = MpcHelper(str(self.config.out_dir))
         sigma0 = self.world.sigma0_map().sigma_m
         if self._helper is not None:  # and builds its solver while we connect
-            self._helper.set_up(self.scenario, sigma0)
+            try:
+                self._helper.set_up(self.scenario, sigma0)
+            except OSError:
+                print("ground station: MPC helper did not start; solving here", file=sys.stderr)
+                self._helper.close()
+                self._helper = None
         self.connect()
         waypoints = self.upload_missions()
         self.arm_all()

@@ -55,7 +55,7 @@ def freeze_startup_heap() -> None:
     """Exempt everything allocated so far (modules, world, solver) from garbage collection.
 
     A long-running process calls this once it is set up: full collections then skip the
-    ~10^5 objects of numpy, pymavlink and casadi, and so does the exit (40 ms -> 10 ms)."""
+    ~10^5 objects of numpy, pymavlink and casadi, and so does the exit (50 ms -> 10 ms)."""
     import gc
 
     gc.freeze()

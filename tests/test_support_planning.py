@@ -98,6 +98,15 @@ def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, mon
         assert threads_after_a_plan() > unset  # numpy's and casadi's OpenBLAS add workers
 
 
+def test_setting_up_a_dead_helper_fails_with_an_os_error(along_world):
+    helper = MpcHelper()
+    helper.process.kill()
+    helper.process.wait()
+    with pytest.raises(OSError):  # the station then solves everything itself
+        helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
+    helper.close()
+
+
 def test_a_dead_helpers_share_is_solved_here(along_world, local, capfd):
     helper = MpcHelper()
     helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
