@@ -3,6 +3,9 @@ dead helper's share solved here."""
 
 from __future__ import annotations
 
+import os
+import sys
+
 import numpy as np
 import pytest
 
@@ -75,10 +78,8 @@ def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along
     assert helper.process.returncode == 0
 
 
-@pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="needs /proc")
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs /proc")
 def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, monkeypatch):
-    import os
-
     def threads_after_a_plan() -> int:
         helper = MpcHelper()
         helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import sys
+
 import numpy as np
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
@@ -234,15 +237,11 @@ def test_geofence_refuses_setpoints_and_the_vehicle_holds(frame, target, reason)
 
 
 def _threads(pid: int) -> int:
-    from pathlib import Path
-
-    return len(list(Path(f"/proc/{pid}/task").iterdir()))
+    return len(os.listdir(f"/proc/{pid}/task"))
 
 
-@pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="needs /proc")
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs /proc")
 def test_a_vehicle_asks_blas_for_one_thread_unless_told(monkeypatch):
-    import os
-
     def threads(setting: str | None) -> int:
         if setting is None:
             monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
