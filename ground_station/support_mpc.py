@@ -41,7 +41,7 @@ import casadi as ca
 import numpy as np
 
 from ground_station.casadi_buffer import BufferedFunction
-from ground_station.localizability import casadi_hermite, hermite_zero_slope
+from ground_station.localizability import hermite_zero_slope, inlined_hermite
 from mission.camera import CameraModel
 from mission.grid import VoxelGrid
 from mission.settings import ControlSettings
@@ -65,23 +65,36 @@ ESCAPE_STARTS = 1  # escape starts solved: the cheapest of six where it starts
 CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
-def compiled_nlp(solver: ca.Function, fallback_dir: Callable[[], str]) -> str | None:
-    """The NLP's functions of ``solver`` compiled into a shared library with the system C
-    compiler (about 1.5x faster solves than interpreting them), or None without one.
+def compiled_nlp(
+    name: str, nlp: dict[str, ca.MX], options: dict, fallback_dir: Callable[[], str]
+) -> str | None:
+    """The functions IPOPT needs for ``nlp`` (keys x, p, f, g) under ``options``, compiled
+    into a shared library with the system C compiler (about 1.5x faster solves than
+    interpreting them), or None without one.
 
     The library is cached (under ``$XDG_CACHE_HOME`` or ``~/.cache``) by the hash of the
-    serialised solver, the casadi version, the compiler and its flags: a run after the first
-    neither generates C nor compiles. The C source is generated in a scratch directory that is
-    gone on return; where the cache cannot be written, the library goes to ``fallback_dir()``.
+    serialised NLP, the solver's name and options, the casadi version, the compiler and its
+    flags: a run after the first builds no solver from the expressions, generates no C and
+    compiles nothing. The C source is generated in a scratch directory that is gone on return;
+    where the cache cannot be written, the library goes to ``fallback_dir()``.
     """
     compiler = shutil.which("gcc") or shutil.which("cc")
     if compiler is None:
         return None
-    recipe = f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}\n{solver.serialize()}"
-    name = f"support_mpc_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
-    cached = _cache_dir() / name
+    functions = ca.Function("nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
+    recipe = "\n".join(
+        [
+            f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}",
+            name,
+            repr(sorted(options.items())),
+            functions.serialize(),
+        ]
+    )
+    library_name = f"support_mpc_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
+    cached = _cache_dir() / library_name
     if cached.is_file():
         return str(cached)
+    solver = ca.nlpsol(name, "ipopt", nlp, options)
     with tempfile.TemporaryDirectory(prefix="support-mpc-c-") as scratch:
         with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
             solver.generate_dependencies("support_mpc_nlp.c")
@@ -90,8 +103,8 @@ def compiled_nlp(solver: ca.Function, fallback_dir: Callable[[], str]) -> str | 
             try:
                 directory = directory_of()
                 directory.mkdir(parents=True, exist_ok=True)
-                library = directory / name
-                partial = directory / f".{name}.{os.getpid()}.part"
+                library = directory / library_name
+                partial = directory / f".{library_name}.{os.getpid()}.part"
                 subprocess.run(
                     [compiler, *COMPILE_FLAGS, str(source), "-o", str(partial)],
                     check=True,
@@ -206,11 +219,13 @@ class SupportMpc:
         def sq(a):
             return ca.sumsqr(a)
 
+        hermite = inlined_hermite(self._window_grid)  # G_s and the prior's, per step
+
         # Steps are also bounded hard (below), where xi(d) = w_interval d^2 exactly: writing it
         # so keeps the cost smooth. The terminal link is solved per branch (module docstring).
         cost = c.w_interval * sq(yhat - v[:, 0])
         for u in range(horizon):
-            cost += c.w_gnss * casadi_hermite(self._window_grid, v[:, u] - corner, values)
+            cost += c.w_gnss * hermite(v[:, u] - corner, values)
             cost += c.w_waypoint * sq(v[:, u] - targets[:, u])
             cost += (1 - blocked[u]) * c.w_relative * sq(work[:, u] - v[:, u])
             cost += blocked[u] * c.w_penalty * sq(anchors[:, u] - v[:, u])
@@ -239,19 +254,17 @@ class SupportMpc:
         shadow = (
             []
             if self.sigma0 is None
-            else [
-                casadi_hermite(self._window_grid, v[:, u] - corner, prior) for u in range(horizon)
-            ]
+            else [hermite(v[:, u] - corner, prior) for u in range(horizon)]
         )
         cost_function = ca.Function(
             "support_mpc_cost", [ca.vec(v), parameters], [cost], ["x", "p"], ["f"]
         )
         constraints = ca.vertcat(*steps, terminal_sq, *shadow)
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": constraints}
-        solver = ca.nlpsol("support_mpc", "ipopt", nlp, IPOPT_OPTIONS)
-        library = compiled_nlp(solver, self._private_library_dir)
-        if library is not None:
-            solver = ca.nlpsol("support_mpc", "ipopt", library, IPOPT_OPTIONS)
+        library = compiled_nlp("support_mpc", nlp, IPOPT_OPTIONS, self._private_library_dir)
+        solver = ca.nlpsol(
+            "support_mpc", "ipopt", nlp if library is None else library, IPOPT_OPTIONS
+        )
         unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
         return (
             BufferedFunction(solver, ("x", "f"), unbounded),

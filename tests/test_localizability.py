@@ -9,7 +9,12 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ground_station.localizability import LocalizabilityMap, casadi_hermite, hermite_zero_slope
+from ground_station.localizability import (
+    LocalizabilityMap,
+    casadi_hermite,
+    hermite_zero_slope,
+    inlined_hermite,
+)
 from mission.grid import VoxelGrid
 from mission.settings import Box
 
@@ -113,6 +118,35 @@ def test_casadi_g_s_equals_numpy_and_has_zero_gradient_at_nodes():
     np.testing.assert_allclose(got, hermite_zero_slope(values, grid, points), atol=1e-12)
     for centre in grid.centers().reshape(-1, 3)[::7]:
         np.testing.assert_allclose(np.array(gradient(centre)).ravel(), 0.0, atol=1e-9)
+
+
+def test_the_inlined_g_s_computes_bit_for_bit_what_the_written_out_one_does():
+    """The MPC builds its horizon's G_s terms from one inlined function: same values, same
+    first and second derivatives, to the last bit, and no function call left in the graph."""
+    rng = np.random.default_rng(10)
+    grid = VoxelGrid(np.zeros(3), 1.0, (7, 6, 5))
+    horizon = 4
+    v = ca.MX.sym("v", 3, horizon)
+    corner = ca.MX.sym("corner", 3)
+    values = ca.MX.sym("values", grid.n_voxels)
+    hermite = inlined_hermite(grid)
+    written = sum(casadi_hermite(grid, v[:, u] - corner, values) for u in range(horizon))
+    inlined = sum(hermite(v[:, u] - corner, values) for u in range(horizon))
+
+    def derivatives(total):
+        hessian = ca.hessian(total, ca.vec(v))[0]
+        return ca.Function(
+            "d", [ca.vec(v), corner, values], [total, ca.gradient(total, ca.vec(v)), hessian]
+        )
+
+    a, b = derivatives(written), derivatives(inlined)
+    assert "hermite" not in str(inlined)  # inlined: the graph holds no call
+    for _ in range(50):
+        x = rng.uniform(-2.0, 9.0, 3 * horizon)
+        shift = rng.uniform(-1.0, 1.0, 3)
+        field = rng.uniform(0.0, 3.0, grid.n_voxels)
+        for got, expected in zip(b(x, shift, field), a(x, shift, field), strict=True):
+            assert np.array_equal(np.array(got), np.array(expected))
 
 
 def test_casadi_g_s_hessian_has_the_mixed_terms_of_the_numpy_field():

@@ -244,7 +244,7 @@ def _has_compiler() -> bool:
     return shutil.which("gcc") is not None or shutil.which("cc") is not None
 
 
-def test_the_compiled_nlp_is_cached_and_no_c_is_generated_on_a_hit(tmp_path, monkeypatch):
+def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypatch):
     import tempfile
 
     import casadi as ca
@@ -256,30 +256,44 @@ def test_the_compiled_nlp_is_cached_and_no_c_is_generated_on_a_hit(tmp_path, mon
     scratch.mkdir()
     monkeypatch.setattr(tempfile, "tempdir", str(scratch))
     nlp, options = _tiny_solver()
-    solver = ca.nlpsol("tiny", "ipopt", nlp, options)
 
     def no_fallback() -> str:
         raise AssertionError("the cache is writable: no fallback directory")
 
-    first = support_mpc.compiled_nlp(solver, no_fallback)
+    first = support_mpc.compiled_nlp("tiny", nlp, options, no_fallback)
     if not _has_compiler():
         assert first is None
         return
     assert first is not None and Path(first).parent == tmp_path / "cache" / "bridge-uav-formation"
     assert list(scratch.iterdir()) == []  # the C source's scratch directory is gone
     mtime = Path(first).stat().st_mtime_ns
+    interpreted = ca.nlpsol("tiny", "ipopt", nlp, options)
 
     def no_scratch(*args, **kwargs):
         raise AssertionError("a cache hit generates no C")
 
-    monkeypatch.setattr(support_mpc.tempfile, "TemporaryDirectory", no_scratch)
-    again = ca.nlpsol("tiny", "ipopt", nlp, options)
-    assert support_mpc.compiled_nlp(again, no_fallback) == first
+    def no_solver(*args, **kwargs):
+        raise AssertionError("a cache hit builds no solver from the expressions")
+
+    with monkeypatch.context() as hit:
+        hit.setattr(support_mpc.tempfile, "TemporaryDirectory", no_scratch)
+        hit.setattr(support_mpc.ca, "nlpsol", no_solver)
+        again, _ = _tiny_solver()  # the same NLP, built afresh
+        assert support_mpc.compiled_nlp("tiny", again, options, no_fallback) == first
     assert Path(first).stat().st_mtime_ns == mtime
     compiled = ca.nlpsol("tiny", "ipopt", first, options)
-    expected = solver(x0=[0, 0], p=1.5, lbg=1.0, ubg=np.inf)["x"]
+    expected = interpreted(x0=[0, 0], p=1.5, lbg=1.0, ubg=np.inf)["x"]
     np.testing.assert_allclose(compiled(x0=[0, 0], p=1.5, lbg=1.0)["x"], expected, atol=1e-9)
     np.testing.assert_allclose(expected, [[1.5], [3.0]], atol=1e-4)  # IPOPT tol 1e-4
+    # Anything that changes the generated functions is a different library.
+    exact_only = {k: v for k, v in options.items() if k != "calc_lam_p"}
+    changed = {**nlp, "f": nlp["f"] + nlp["x"][0]}
+    others = [
+        support_mpc.compiled_nlp("tiny", changed, options, no_fallback),
+        support_mpc.compiled_nlp("tiny", nlp, exact_only, no_fallback),
+        support_mpc.compiled_nlp("other", nlp, options, no_fallback),
+    ]
+    assert len({first, *others}) == 4
 
 
 def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monkeypatch):
@@ -292,9 +306,7 @@ def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monk
     monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
     fallback = tmp_path / "private"
     nlp, options = _tiny_solver()
-    library = support_mpc.compiled_nlp(
-        ca.nlpsol("tiny", "ipopt", nlp, options), lambda: str(fallback)
-    )
+    library = support_mpc.compiled_nlp("tiny", nlp, options, lambda: str(fallback))
     if not _has_compiler():
         assert library is None
         return
