@@ -12,6 +12,8 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
@@ -249,36 +251,48 @@ def _scipy_over_casadi(world, plan, problems: int) -> float:
 
 
 def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchResult]:
-    """Lockstep runs: Along AC's real-time factor, the median of ``repeats`` runs as
-    ``mission run`` makes them (MPC helper where there is a core for it); and the wall time of
-    the full Table 3 batch, estimated as trials x (sum of one run per scenario and method,
-    made as the batch makes them) / jobs."""
+    """Lockstep runs, each a ``python -m mission run`` process as a user or a batch starts it:
+    Along AC's real-time factor, the median of ``repeats`` runs (MPC helper where there is a
+    core for it); and the wall time of the full Table 3 batch, estimated as trials x (sum of
+    one run per scenario and method, made as the batch makes them) / jobs."""
     import tempfile
     from pathlib import Path
 
     from mission.batch import helper_has_a_core
-    from mission.orchestrator import RunOptions, run_mission
-    from mission.scenario import load_scenario
 
     factors, walls = [], []
     in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)
     with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
-        along = load_scenario("along")
         for repeat in range(repeats):
             out = Path(temp) / f"along-ac-{repeat}"
-            factors.append(run_mission(RunOptions("along", "ac", 0, out), along)["realtime_factor"])
+            factors.append(run_as_command("along", "ac", out)["realtime_factor"])
         for name in ("along", "wall"):
-            scenario = load_scenario(name)
             for method in ("ac", "nac"):
                 out = Path(temp) / f"batch-{name}-{method}"
-                options = RunOptions(name, method, 0, out, mpc_helper=in_batch)
-                walls.append(run_mission(options, scenario)["wall_time_s"])
+                walls.append(run_as_command(name, method, out, in_batch)["wall_time_s"])
     factor = statistics.median(factors)
     estimate = trials * sum(walls) / jobs
     return [
         BenchResult("realtime_factor_lockstep", factor, "x", ">= 30", factor >= 30),
         BenchResult("table3_wall_s_estimate", estimate, "s", "<= 600", estimate <= 600),
     ]
+
+
+def run_as_command(
+    scenario: str, method: str, out: Path, mpc_helper: bool | None = None
+) -> dict[str, Any]:
+    """The summary of ``python -m mission run SCENARIO --method METHOD --seed 0 --out OUT``
+    (a fresh process: this one may have threads that keep it from forking vehicles)."""
+    import json
+
+    helper = [] if mpc_helper is None else ["--mpc-helper" if mpc_helper else "--no-mpc-helper"]
+    command = [sys.executable, "-m", "mission", "run", scenario, "--method", method]
+    subprocess.run(
+        [*command, "--seed", "0", "--out", str(out), *helper],
+        check=True,
+        stdout=subprocess.DEVNULL,
+    )
+    return json.loads((out / "summary.json").read_text())
 
 
 BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {

@@ -102,6 +102,14 @@ def build_parser() -> OneLineArgumentParser:
         help="the ground station shares the support MPCs with a helper process "
         "(default: with two or more cores; same results either way)",
     )
+    run.add_argument(
+        "--vehicle-start",
+        choices=["fork", "exec"],
+        default="fork",
+        help="fork: the vehicles are forked from this process after one import of their code "
+        "(exec where forking is unsafe); exec: each is started as python -m vehicle_sim "
+        "(slower; ps shows its command line). Same results either way",
+    )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
     batch = commands.add_parser(
@@ -195,6 +203,7 @@ def _run(args) -> int:
         args.observer,
         link,
         args.mpc_helper,
+        args.vehicle_start,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     try:

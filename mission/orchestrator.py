@@ -1,5 +1,10 @@
 """``mission run``: one process per vehicle and a ground station, on free loopback ports.
 
+The ground station is started first (``python -m ground_station``); while it imports, this
+process imports the vehicle simulator once and forks the four vehicles from it
+(:mod:`mission.forked`), or starts each as ``python -m vehicle_sim`` where forking is not safe
+or ``vehicle_start="exec"`` asks for it. Either way the results are the same.
+
 Children write their stderr to ``DIR/<name>.log``; all of them are stopped when the run ends,
 fails, or is interrupted, and die with this process if it is killed (``--exit-with-parent``).
 """
@@ -13,14 +18,15 @@ import socket
 import subprocess
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from mission.analysis import analyze_tlog, mpc_stats
 from mission.atomic import write_text_atomically
 from mission.cli_common import child_environment
+from mission.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.link_impairment import LinkSettings
 from mission.plan_files import vehicle_names
 from mission.settings import Scenario
@@ -46,6 +52,11 @@ class RunOptions:
     observer: str | None = None  # HOST:PORT every vehicle also streams to
     link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
     mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
+    vehicle_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
+
+    def __post_init__(self) -> None:
+        if self.vehicle_start not in ("fork", "exec"):
+            raise ValueError(f"vehicle_start must be fork or exec, not {self.vehicle_start!r}")
 
 
 @dataclass
@@ -53,7 +64,7 @@ class Child:
     """A started child process and its log."""
 
     name: str
-    process: subprocess.Popen
+    process: subprocess.Popen | ForkedProcess
     log: Path
 
 
@@ -80,25 +91,12 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
             "--exit-with-parent",
         ]
         names = vehicle_names(scenario.task.supports)
-        # Every socket is bound here and inherited, so all processes start at once: the
-        # ground station knows every address before any vehicle has printed its banner.
+        # Every socket is bound here and inherited, so the ground station starts first knowing
+        # every address, before any vehicle has printed its banner.
         sockets = {name: _bound_udp() for name in names}
         truth_sockets = {name: _bound_udp() for name in names[1:]}
         truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
-        for name in names:
-            fds = [sockets[name].fileno()]
-            arguments = ["-m", "vehicle_sim", "--vehicle", name, "--socket-fd", str(fds[0])]
-            if name in truth_sockets:
-                fds.append(truth_sockets[name].fileno())
-                arguments += ["--truth-socket-fd", str(fds[1])]
-            else:
-                arguments += truth_out
-            children.append(
-                _start(options.out_dir, name, [*arguments, *observer, *common], pass_fds=fds)
-            )
         addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
-        for sock in (*sockets.values(), *truth_sockets.values()):
-            sock.close()  # the children hold them now
         helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
         gcs = _start(
             options.out_dir,
@@ -117,6 +115,25 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
             ],
         )
         children.append(gcs)
+        vehicle_main = _vehicle_main(options.vehicle_start)
+        for name in names:
+            fds = [sockets[name].fileno()]
+            arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
+            if name in truth_sockets:
+                fds.append(truth_sockets[name].fileno())
+                arguments += ["--truth-socket-fd", str(fds[1])]
+            else:
+                arguments += truth_out
+            arguments += [*observer, *common]
+            if vehicle_main is None:
+                child = _start(options.out_dir, name, ["-m", "vehicle_sim", *arguments], fds)
+            else:
+                log = options.out_dir / f"{name}.log"
+                forked = start_forked(vehicle_main, arguments, log, fds, child_environment())
+                child = Child(name, forked, log)
+            children.append(child)
+        for sock in (*sockets.values(), *truth_sockets.values()):
+            sock.close()  # the children hold them now
         _supervise(gcs, children, required={"work"})
         if gcs.process.returncode != 0:
             raise RunFailed(
@@ -142,6 +159,15 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         summary["link"] = json.loads(link_file.read_text())
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
+
+
+def _vehicle_main(vehicle_start: str) -> Callable[[list[str]], int] | None:
+    """The vehicle's entry point to fork, imported here once; None: start each by exec."""
+    if vehicle_start != "fork" or not fork_is_safe():
+        return None
+    from vehicle_sim.cli import entry_point
+
+    return entry_point
 
 
 def _flag(name: str, on: bool) -> str:

@@ -37,6 +37,15 @@ class VehicleProcess:
         return stop_process(self.process)
 
 
+def vehicle_pids(parent: int, vehicle: str) -> list[int]:
+    """The pids of ``parent``'s vehicle processes named ``vsim-VEHICLE`` (each vehicle names
+    itself so, whether `mission run` forked it or started it as ``python -m vehicle_sim``)."""
+    found = subprocess.run(
+        ["pgrep", "-P", str(parent), "-x", f"vsim-{vehicle}"[:15]], capture_output=True, text=True
+    )
+    return [int(pid) for pid in found.stdout.split()]
+
+
 def stop_process(process: subprocess.Popen, timeout_s: float = 10.0) -> str:
     """SIGTERM, then SIGKILL after ``timeout_s``; return the rest of stderr."""
     if process.poll() is None:

@@ -59,18 +59,16 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     as a two-job batch makes them on this machine (helper only with a core for each)."""
     import os
 
-    import mission.orchestrator
-
     factors = iter([20.0, 31.0, 35.0])  # median 31: not the first, last or mean
     calls = []
 
-    def fake_run(options, scenario):
-        calls.append((options.scenario, options.method, options.mpc_helper))
+    def fake_run(scenario, method, out, mpc_helper=None):
+        calls.append((scenario, method, mpc_helper))
         if len(calls) <= 3:
             return {"realtime_factor": next(factors), "wall_time_s": 9.0}
-        return {"realtime_factor": 1.0, "wall_time_s": {"along": 10.0, "wall": 12.0}[scenario.name]}
+        return {"realtime_factor": 1.0, "wall_time_s": {"along": 10.0, "wall": 12.0}[scenario]}
 
-    monkeypatch.setattr(mission.orchestrator, "run_mission", fake_run)
+    monkeypatch.setattr(bench, "run_as_command", fake_run)
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
     rows = {r.name: r for r in bench.bench_runs(trials=15, jobs=2, repeats=3)}
     assert rows["realtime_factor_lockstep"].value == 31.0 and rows["realtime_factor_lockstep"].ok

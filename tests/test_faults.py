@@ -15,7 +15,7 @@ import pytest
 
 from mission.analysis import read_tlog
 from mission.scenario import load_scenario
-from tests.processes import ROOT, stop_process
+from tests.processes import ROOT, stop_process, vehicle_pids
 
 FAULT_SCENARIO = "extends: along\nname: fault-run\n"
 BANNER = re.compile(r"listening on [\d.]+:(\d+), truth port (\d+)")
@@ -65,9 +65,9 @@ def test_a_killed_support_is_dropped_then_taken_back(scenario, tmp_path):
     try:
         _wait_cycles(out, 60)
         port, truth_port = BANNER.search((out / "support-2.log").read_text()).groups()
-        victim = _pids(f"--vehicle support-2 .*{scenario}")
+        victim = vehicle_pids(run.pid, "support-2")
         assert len(victim) == 1
-        subprocess.run(["kill", "-9", *victim], check=True)
+        subprocess.run(["kill", "-9", str(victim[0])], check=True)
         killed_at = _cycles(out)
         _wait_cycles(out, killed_at + 20)  # lost after 3 s = 6 cycles; let it run without
         restarted = subprocess.Popen(
@@ -204,7 +204,7 @@ def test_a_silent_work_uav_ends_the_run_from_the_ground_station(scenario, tmp_pa
     work: list[str] = []
     try:
         _wait_cycles(out, 40)
-        work = _pids(f"--vehicle work .*{scenario}")
+        work = [str(pid) for pid in vehicle_pids(run.pid, "work")]
         assert len(work) == 1
         subprocess.run(["kill", "-STOP", *work], check=True)
         _, stderr = run.communicate(timeout=120)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.processes import ROOT
+from tests.processes import ROOT, vehicle_pids
 
 SHORT = """
 extends: along
@@ -109,12 +109,21 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert metrics == {k: summary[k] for k in metrics}, "the tlog alone gives the same metrics"
     assert summary["scenario_source"] == str(scenario)
 
-    # The same seed again, with every link signed and every MPC solved in the ground station
-    # (no helper process): identical results.
+    # The same seed again, with every link signed, every MPC solved in the ground station (no
+    # helper process), and each vehicle started as `python -m vehicle_sim` instead of forked:
+    # identical results.
     key = tmp_path / "link.key"
     key.write_bytes(bytes(range(32)))
     again = _run(
-        scenario, tmp_path / "b", "--seed", "2", "--signing-key", str(key), "--no-mpc-helper"
+        scenario,
+        tmp_path / "b",
+        "--seed",
+        "2",
+        "--signing-key",
+        str(key),
+        "--no-mpc-helper",
+        "--vehicle-start",
+        "exec",
     )
     assert again.returncode == 0, again.stderr
     second = json.loads((tmp_path / "b" / "summary.json").read_text())
@@ -175,11 +184,12 @@ def test_a_dead_work_vehicle_ends_the_run_with_a_clear_error(scenario, tmp_path)
         while time.monotonic() < deadline and not (out / "gcs.tlog").exists():
             time.sleep(0.1)
         time.sleep(1.0)
-        work = subprocess.run(
-            ["pgrep", "-f", "--", f"--vehicle work .*{scenario}"], capture_output=True, text=True
-        ).stdout.split()
-        assert work, "the work vehicle is running"
-        subprocess.run(["kill", "-9", *work], check=True)
+        work = vehicle_pids(run.pid, "work")
+        assert len(work) == 1, "the work vehicle is running"
+        # forked from the run (by default): its command line is the run's
+        command = Path(f"/proc/{work[0]}/cmdline").read_bytes().split(b"\0")
+        assert command[1:4] == [b"-m", b"mission", b"run"]
+        subprocess.run(["kill", "-9", str(work[0])], check=True)
         _, stderr = run.communicate(timeout=120)
     finally:
         if run.poll() is None:

@@ -14,6 +14,7 @@ from mission.cli_common import (
     add_link_arguments,
     freeze_startup_heap,
     link_settings,
+    name_this_process,
     parse_point,
     run_guarded,
 )
@@ -101,6 +102,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Start the vehicle and serve until terminated."""
     args = build_parser().parse_args(argv)
     identity = _identity(args.vehicle)
+    name_this_process(f"vsim-{identity.name}")  # forked by `mission run`, it has no own argv
     if args.speedup is not None and not (0 < args.speedup <= 1000):
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
     if args.socket_fd is not None and args.port is not None:

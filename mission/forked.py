@@ -1,0 +1,150 @@
+"""Start a child process by forking this one: the child calls a function of this program
+instead of starting a new interpreter, so it skips Python's start-up and every import this
+process has already made.
+
+``mission run`` starts its four vehicles this way once it has imported their code: the four
+imports of numpy, pymavlink and the simulator (~0.25 s of CPU each) become one, on a machine
+whose two cores the six processes of a run share while they set up. A forked child is a
+process like any other (its own pid, sockets and log; signals and exit statuses as with
+``subprocess.Popen``); only its command line is its parent's.
+
+A fork copies just the calling thread, so a lock another thread holds (in malloc, a logging
+handler, a BLAS pool) would stay held in the child: :func:`fork_is_safe` allows it only while
+this process has one thread.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import os
+import signal
+import subprocess
+import sys
+import time
+import traceback
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+
+POLL_S = 0.005  # how often wait() looks at a child that has not exited
+
+
+def fork_is_safe() -> bool:
+    """Whether this process may fork a child that goes on running Python: Linux (its
+    ``/proc`` shows the threads) and a single thread."""
+    if not hasattr(os, "fork"):
+        return False
+    try:
+        return len(os.listdir("/proc/self/task")) == 1
+    except OSError:
+        return False
+
+
+class ForkedProcess:
+    """A forked child, driven like the ``subprocess.Popen`` it stands in for."""
+
+    def __init__(self, pid: int) -> None:
+        self.pid = pid
+        self.returncode: int | None = None
+
+    def poll(self) -> int | None:
+        """The exit status (negative: the signal that ended it), or None while it runs."""
+        if self.returncode is None:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid == self.pid:
+                self.returncode = os.waitstatus_to_exitcode(status)
+        return self.returncode
+
+    def wait(self, timeout: float | None = None) -> int:
+        """Wait for the exit status; ``subprocess.TimeoutExpired`` after ``timeout`` s."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while (code := self.poll()) is None:
+            if deadline is not None and time.monotonic() >= deadline:
+                raise subprocess.TimeoutExpired(f"forked child {self.pid}", timeout or 0.0)
+            time.sleep(POLL_S)
+        return code
+
+    def send_signal(self, number: int) -> None:
+        """Signal the child unless it has been waited for (its pid may be reused)."""
+        if self.poll() is None:
+            os.kill(self.pid, number)
+
+    def terminate(self) -> None:
+        """SIGTERM."""
+        self.send_signal(signal.SIGTERM)
+
+    def kill(self) -> None:
+        """SIGKILL."""
+        self.send_signal(signal.SIGKILL)
+
+
+def start_forked(
+    main: Callable[[list[str]], int | None],
+    argv: Sequence[str],
+    log: Path,
+    keep_fds: Sequence[int] = (),
+    environment: Mapping[str, str] | None = None,
+) -> ForkedProcess:
+    """Fork a child that runs ``main(argv)`` and exits with its status.
+
+    Its stdout and stderr go to ``log`` (created or truncated), stdin reads /dev/null, and of
+    this process's descriptors it keeps only ``keep_fds``; signal dispositions are Python's
+    defaults again and ``environment`` is merged into its ``os.environ``. Call it only when
+    :func:`fork_is_safe`.
+    """
+    descriptor = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+    for stream in (sys.stdout, sys.stderr):  # or the child would write them out again
+        if stream is not None:
+            stream.flush()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover (the child's coverage is not collected)
+        _child(main, list(argv), descriptor, keep_fds, environment or {})
+    os.close(descriptor)
+    return ForkedProcess(pid)
+
+
+def _child(
+    main: Callable[[list[str]], int | None],
+    argv: list[str],
+    log_descriptor: int,
+    keep_fds: Sequence[int],
+    environment: Mapping[str, str],
+) -> None:
+    """The forked side: set up, run, and leave through ``os._exit`` whatever happens (never
+    through the parent's stack, ``finally`` blocks or exit handlers)."""
+    status = 1
+    try:
+        # Everything inherited stays out of the collector: a parent's object freed here could
+        # close a descriptor number the child has since reused.
+        gc.freeze()
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.set_wakeup_fd(-1)
+        os.dup2(log_descriptor, 1)
+        os.dup2(log_descriptor, 2)
+        null = os.open(os.devnull, os.O_RDONLY)
+        os.dup2(null, 0)
+        keep = {0, 1, 2, *keep_fds}
+        for name in os.listdir("/proc/self/fd"):
+            if int(name) not in keep:
+                with contextlib.suppress(OSError):  # the listing's own, closed already
+                    os.close(int(name))
+        # as a fresh interpreter writing to a file would: stdout in blocks, stderr by lines
+        sys.stdin = open(0, encoding="utf-8", closefd=False)  # noqa: SIM115
+        sys.stdout = open(1, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+        sys.stderr = open(2, "w", encoding="utf-8", buffering=1, closefd=False)  # noqa: SIM115
+        os.environ.update(environment)
+        result = main(argv)
+        status = result if isinstance(result, int) else 0
+    except SystemExit as stop:
+        status = stop.code if isinstance(stop.code, int) else (0 if stop.code is None else 1)
+    except KeyboardInterrupt:
+        status = 128 + signal.SIGINT
+    except BaseException:
+        traceback.print_exc()
+    finally:
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        finally:
+            os._exit(status)
