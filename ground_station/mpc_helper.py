@@ -7,7 +7,11 @@ station's), then lists of
 :class:`~ground_station.support_mpc.PlanRequest`, each answered with the list of plans or an
 error text. A frame is a 4-byte big-endian length and a pickle; both ends are this program.
 The helper ends at end of input, i.e. when the ground station closes the pipe or dies.
-``--for LABEL`` (the ground station passes its output directory) only names it in ``ps``.
+
+A ground station with one thread forks its helper (:mod:`mission.forked`), which then serves
+two pipes (:func:`serve_descriptors`) with the station's imports already made; otherwise it
+starts ``python -m ground_station.mpc_helper``, whose ``--for LABEL`` (the station's output
+directory) only names it in ``ps``. Either way it calls itself ``gcs-mpc-helper``.
 """
 
 from __future__ import annotations
@@ -67,11 +71,29 @@ def serve(requests: BinaryIO, answers: BinaryIO) -> None:
         write_frame(answers, answer)
 
 
+PROCESS_NAME = "gcs-mpc-helper"
+
+
 def main() -> int:
     """Serve on stdin/stdout; Ctrl-C is the ground station's to handle (it closes the pipe)."""
+    return _serve_quietly(sys.stdin.buffer, sys.stdout.buffer)
+
+
+def serve_descriptors(argv: list[str]) -> int:
+    """Serve the pipe ends whose descriptors are ``argv``: requests in, answers out (the
+    forked helper's entry point)."""
+    requests, answers = (int(descriptor) for descriptor in argv)
+    with open(requests, "rb") as incoming, open(answers, "wb") as outgoing:
+        return _serve_quietly(incoming, outgoing)
+
+
+def _serve_quietly(requests: BinaryIO, answers: BinaryIO) -> int:
+    from mission.cli_common import name_this_process
+
+    name_this_process(PROCESS_NAME)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(BrokenPipeError):  # the ground station went away
-        serve(sys.stdin.buffer, sys.stdout.buffer)
+        serve(requests, answers)
     return 0
 
 

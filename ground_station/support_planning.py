@@ -11,15 +11,18 @@ whichever process made them; only the timing differs.
 from __future__ import annotations
 
 import contextlib
+import os
 import subprocess
 import sys
 from collections.abc import Callable
+from typing import BinaryIO
 
 import numpy as np
 
 from ground_station.mpc_helper import read_frame, write_frame
 from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
 from mission.cli_common import child_environment
+from mission.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.settings import Scenario
 
 SET_UP_PIPE_BYTES = 1 << 20  # the set-up frame (a sigma_0 map of 40,000 voxels) is ~0.3 MB
@@ -116,25 +119,20 @@ class MpcHelper:
     """The helper process: started early (it builds its solver while the ground station
     connects), fed request lists, stopped by closing its input."""
 
-    def __init__(self, label: str = "") -> None:
-        """Start the helper; ``label`` (e.g. the run's directory) goes on its command line,
-        so ``ps`` tells whose helper it is. Its set-up follows with :meth:`set_up`."""
-        self.process = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "ground_station.mpc_helper",
-                *(["--for", label] if label else []),
-            ],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            env=child_environment(),
-        )
-        assert self.process.stdin is not None
+    def __init__(self, label: str = "", fork: bool = True) -> None:
+        """Start the helper: forked from this process where that is safe and ``fork`` allows
+        it, else as ``python -m ground_station.mpc_helper --for LABEL`` (``label``, e.g. the
+        run's directory, tells ``ps`` whose helper it is). Its set-up follows with
+        :meth:`set_up`."""
+        self.process: subprocess.Popen | ForkedProcess
+        if fork and fork_is_safe():
+            self.process, self._requests, self._answers = _forked_helper()
+        else:
+            self.process, self._requests, self._answers = _executed_helper(label)
         with contextlib.suppress(ImportError, OSError, AttributeError):  # else writes may wait
             import fcntl
 
-            fcntl.fcntl(self.process.stdin.fileno(), fcntl.F_SETPIPE_SZ, SET_UP_PIPE_BYTES)
+            fcntl.fcntl(self._requests.fileno(), fcntl.F_SETPIPE_SZ, SET_UP_PIPE_BYTES)
 
     def set_up(self, scenario: Scenario, sigma0_m: np.ndarray) -> None:
         """Send the scenario and the sigma_0 map, so the helper builds the same solver as
@@ -144,22 +142,48 @@ class MpcHelper:
 
     def send(self, value) -> None:
         """One frame to the helper (BrokenPipeError if it is gone)."""
-        assert self.process.stdin is not None
-        write_frame(self.process.stdin, value)
+        write_frame(self._requests, value)
 
     def receive(self):
         """The helper's next answer (EOFError if it is gone)."""
-        assert self.process.stdout is not None
-        return read_frame(self.process.stdout)
+        return read_frame(self._answers)
 
     def close(self) -> None:
         """Close its input, so it ends, and wait for it."""
-        for stream in (self.process.stdin, self.process.stdout):
-            if stream is not None:
-                with contextlib.suppress(OSError):
-                    stream.close()
+        for stream in (self._requests, self._answers):
+            with contextlib.suppress(OSError):
+                stream.close()
         try:
             self.process.wait(timeout=5)
         except subprocess.TimeoutExpired:
             self.process.kill()
             self.process.wait()
+
+
+def _forked_helper() -> tuple[ForkedProcess, BinaryIO, BinaryIO]:
+    """A helper forked from this process: (process, its requests' writer, answers' reader)."""
+    from ground_station.mpc_helper import serve_descriptors
+
+    requests_in, requests_out = os.pipe()
+    answers_in, answers_out = os.pipe()
+    child_ends = [requests_in, answers_out]
+    try:
+        process = start_forked(
+            serve_descriptors, [str(d) for d in child_ends], None, child_ends, child_environment()
+        )
+    finally:
+        for descriptor in child_ends:
+            os.close(descriptor)
+    return process, open(requests_out, "wb"), open(answers_in, "rb")
+
+
+def _executed_helper(label: str) -> tuple[subprocess.Popen, BinaryIO, BinaryIO]:
+    """``python -m ground_station.mpc_helper``: (process, its stdin, its stdout)."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ground_station.mpc_helper", *(["--for", label] if label else [])],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        env=child_environment(),
+    )
+    assert process.stdin is not None and process.stdout is not None
+    return process, process.stdin, process.stdout

@@ -81,32 +81,33 @@ class ForkedProcess:
 def start_forked(
     main: Callable[[list[str]], int | None],
     argv: Sequence[str],
-    log: Path,
+    log: Path | None,
     keep_fds: Sequence[int] = (),
     environment: Mapping[str, str] | None = None,
 ) -> ForkedProcess:
     """Fork a child that runs ``main(argv)`` and exits with its status.
 
-    Its stdout and stderr go to ``log`` (created or truncated), stdin reads /dev/null, and of
-    this process's descriptors it keeps only ``keep_fds``; signal dispositions are Python's
-    defaults again and ``environment`` is merged into its ``os.environ``. Call it only when
-    :func:`fork_is_safe`.
+    Its stdout and stderr go to ``log`` (created or truncated; None: they stay this
+    process's), stdin reads /dev/null, and of this process's other descriptors it keeps only
+    ``keep_fds``; signal dispositions are Python's defaults again and ``environment`` is
+    merged into its ``os.environ``. Call it only when :func:`fork_is_safe`.
     """
-    descriptor = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+    descriptor = None if log is None else os.open(log, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
     for stream in (sys.stdout, sys.stderr):  # or the child would write them out again
         if stream is not None:
             stream.flush()
     pid = os.fork()
     if pid == 0:  # pragma: no cover (the child's coverage is not collected)
         _child(main, list(argv), descriptor, keep_fds, environment or {})
-    os.close(descriptor)
+    if descriptor is not None:
+        os.close(descriptor)
     return ForkedProcess(pid)
 
 
 def _child(
     main: Callable[[list[str]], int | None],
     argv: list[str],
-    log_descriptor: int,
+    log_descriptor: int | None,
     keep_fds: Sequence[int],
     environment: Mapping[str, str],
 ) -> None:
@@ -120,8 +121,9 @@ def _child(
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         signal.set_wakeup_fd(-1)
-        os.dup2(log_descriptor, 1)
-        os.dup2(log_descriptor, 2)
+        if log_descriptor is not None:
+            os.dup2(log_descriptor, 1)
+            os.dup2(log_descriptor, 2)
         null = os.open(os.devnull, os.O_RDONLY)
         os.dup2(null, 0)
         keep = {0, 1, 2, *keep_fds}

@@ -118,9 +118,19 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
     run = _start_run(scenario, out, "--mpc-helper")
     try:
         _wait_cycles(out, 40)
-        gcs = _pids(f"-m ground_station .*{scenario}")
+        gcs = subprocess.run(  # the run's child (its helper has the same command line)
+            ["pgrep", "-P", str(run.pid), "-f", "--", "-m ground_station"],
+            capture_output=True,
+            text=True,
+        ).stdout.split()
         assert len(gcs) == 1
-        assert len(_pids(f"ground_station.mpc_helper --for {out}")) == 1
+        helper = subprocess.run(
+            ["pgrep", "-P", gcs[0], "-x", "gcs-mpc-helper"], capture_output=True, text=True
+        ).stdout.split()
+        assert len(helper) == 1
+        # forked from the ground station (it had one thread): its command line is the station's
+        command = Path(f"/proc/{helper[0]}/cmdline").read_bytes().split(b"\0")
+        assert command[1:3] == [b"-m", b"ground_station"]
         subprocess.run(["kill", "-9", *gcs], check=True)
         _, stderr = run.communicate(timeout=120)
     finally:
@@ -132,9 +142,9 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
     assert len(trace.ticks) >= 40  # every flushed cycle is there and parses
     assert _pids(str(scenario)) == []
     deadline = time.monotonic() + 10  # the helper ends at the end of its input
-    while _pids(f"ground_station.mpc_helper --for {out}") and time.monotonic() < deadline:
+    while Path(f"/proc/{helper[0]}").exists() and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert _pids(f"ground_station.mpc_helper --for {out}") == []
+    assert not Path(f"/proc/{helper[0]}").exists()
 
 
 def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp_path):

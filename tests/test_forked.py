@@ -69,6 +69,19 @@ def test_exceptions_and_exit_calls_become_exit_statuses(tmp_path):
     assert exited.wait(timeout=30) == 3
 
 
+def _say(argv: list[str]) -> int:
+    print(f"out {argv[0]}", flush=True)
+    sys.stderr.write(f"err {argv[0]}\n")
+    return 0
+
+
+def test_without_a_log_the_child_writes_where_this_process_does(capfd):
+    child = start_forked(_say, ["hello"], None)
+    assert child.wait(timeout=30) == 0
+    captured = capfd.readouterr()
+    assert "out hello" in captured.out and "err hello" in captured.err
+
+
 def _sleep(argv: list[str]) -> int:
     time.sleep(60)
     return 0

@@ -56,11 +56,10 @@ def _children_of(scenario: Path) -> list[str]:
     return found.stdout.split()
 
 
-def _helpers(out: Path) -> list[str]:
-    """The run's ground-station MPC helper, if it is still alive."""
-    found = subprocess.run(
-        ["pgrep", "-f", f"ground_station.mpc_helper --for {out}"], capture_output=True, text=True
-    )
+def _processes_of(out: Path) -> list[str]:
+    """Processes whose command line names the run's directory: the ground station, its MPC
+    helper (forked, or started with ``--for DIR``) and the vehicles (forked by the run)."""
+    found = subprocess.run(["pgrep", "-f", "--", str(out)], capture_output=True, text=True)
     return found.stdout.split()
 
 
@@ -88,7 +87,7 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert summary["mpc_solve_ms"]["median"] > 0
     assert (tmp_path / "a" / "gcs.tlog").stat().st_size > 0
     assert _children_of(scenario) == []
-    assert _helpers(tmp_path / "a") == []
+    assert _processes_of(tmp_path / "a") == []
     analyzed = subprocess.run(
         [sys.executable, "-m", "mission", "analyze", str(tmp_path / "a"), "--plots"],
         capture_output=True,

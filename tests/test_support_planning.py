@@ -81,7 +81,7 @@ def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs /proc")
 def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, monkeypatch):
     def threads_after_a_plan() -> int:
-        helper = MpcHelper()
+        helper = MpcHelper(fork=False)  # a fresh interpreter: its BLAS reads the environment
         helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
         shared = HelperPlanner(local.mpc, local.observable, helper)
         try:
