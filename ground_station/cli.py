@@ -15,6 +15,7 @@ from mission.cli_common import (
     add_link_arguments,
     die_with_parent,
     link_settings,
+    name_this_process,
     run_guarded,
 )
 from mission.errors import InputError
@@ -103,6 +104,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from ground_station.support_planning import HelperError
 
     args = build_parser().parse_args(argv)
+    name_this_process("ground_station")  # forked by `mission run`, it has no own argv
     if args.exit_with_parent:
         die_with_parent()
     world = World.load(args.scenario)

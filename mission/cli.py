@@ -103,12 +103,13 @@ def build_parser() -> OneLineArgumentParser:
         "(default: with two or more cores; same results either way)",
     )
     run.add_argument(
-        "--vehicle-start",
+        "--process-start",
         choices=["fork", "exec"],
         default="fork",
-        help="fork: the vehicles are forked from this process after one import of their code "
-        "(exec where forking is unsafe); exec: each is started as python -m vehicle_sim "
-        "(slower; ps shows its command line). Same results either way",
+        help="fork: the ground station and the vehicles are forked from this process, the "
+        "vehicles after one import of their code (exec where forking is unsafe); exec: each is "
+        "started as python -m ground_station / vehicle_sim (slower; ps shows its command "
+        "line). Same results either way",
     )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
@@ -203,7 +204,7 @@ def _run(args) -> int:
         args.observer,
         link,
         args.mpc_helper,
-        args.vehicle_start,
+        args.process_start,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     try:

@@ -1,9 +1,9 @@
 """``mission run``: one process per vehicle and a ground station, on free loopback ports.
 
-The ground station is started first (``python -m ground_station``); while it imports, this
-process imports the vehicle simulator once and forks the four vehicles from it
-(:mod:`mission.forked`), or starts each as ``python -m vehicle_sim`` where forking is not safe
-or ``vehicle_start="exec"`` asks for it. Either way the results are the same.
+The ground station is forked first (:mod:`mission.forked`) and imports its own code; meanwhile
+this process imports the vehicle simulator once and forks the four vehicles. Where forking is
+not safe, or ``process_start="exec"`` asks for it, each is started as ``python -m
+ground_station`` or ``python -m vehicle_sim`` instead. Either way the results are the same.
 
 Children write their stderr to ``DIR/<name>.log``; all of them are stopped when the run ends,
 fails, or is interrupted, and die with this process if it is killed (``--exit-with-parent``).
@@ -52,11 +52,11 @@ class RunOptions:
     observer: str | None = None  # HOST:PORT every vehicle also streams to
     link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
     mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
-    vehicle_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
+    process_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
 
     def __post_init__(self) -> None:
-        if self.vehicle_start not in ("fork", "exec"):
-            raise ValueError(f"vehicle_start must be fork or exec, not {self.vehicle_start!r}")
+        if self.process_start not in ("fork", "exec"):
+            raise ValueError(f"process_start must be fork or exec, not {self.process_start!r}")
 
 
 @dataclass
@@ -98,24 +98,18 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
         addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
         helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
-        gcs = _start(
+        forking = options.process_start == "fork" and fork_is_safe()
+        station = ["--method", options.method, "--vehicles", addresses]
+        station += ["--out", str(options.out_dir), *helper, *common]
+        gcs = _launch(
             options.out_dir,
             "ground_station",
-            [
-                "-m",
-                "ground_station",
-                "--method",
-                options.method,
-                "--vehicles",
-                addresses,
-                "--out",
-                str(options.out_dir),
-                *helper,
-                *common,
-            ],
+            station,
+            (),
+            _ground_station_main if forking else None,
         )
         children.append(gcs)
-        vehicle_main = _vehicle_main(options.vehicle_start)
+        vehicle_main = _vehicle_main() if forking else None
         for name in names:
             fds = [sockets[name].fileno()]
             arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
@@ -125,13 +119,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
             else:
                 arguments += truth_out
             arguments += [*observer, *common]
-            if vehicle_main is None:
-                child = _start(options.out_dir, name, ["-m", "vehicle_sim", *arguments], fds)
-            else:
-                log = options.out_dir / f"{name}.log"
-                forked = start_forked(vehicle_main, arguments, log, fds, child_environment())
-                child = Child(name, forked, log)
-            children.append(child)
+            children.append(_launch(options.out_dir, name, arguments, fds, vehicle_main))
         for sock in (*sockets.values(), *truth_sockets.values()):
             sock.close()  # the children hold them now
         _supervise(gcs, children, required={"work"})
@@ -161,13 +149,19 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     return summary
 
 
-def _vehicle_main(vehicle_start: str) -> Callable[[list[str]], int] | None:
-    """The vehicle's entry point to fork, imported here once; None: start each by exec."""
-    if vehicle_start != "fork" or not fork_is_safe():
-        return None
+def _vehicle_main() -> Callable[[list[str]], int]:
+    """The vehicles' entry point, imported here once for the four forks."""
     from vehicle_sim.cli import entry_point
 
     return entry_point
+
+
+def _ground_station_main(argv: list[str]) -> int:
+    """The forked ground station: it imports its own code (casadi and the MPCs), while this
+    process goes on to the vehicles."""
+    from ground_station.cli import entry_point
+
+    return entry_point(argv)
 
 
 def _flag(name: str, on: bool) -> str:
@@ -191,11 +185,23 @@ def _address_of(sock: socket.socket) -> str:
     return f"{host}:{port}"
 
 
-def _start(out_dir: Path, name: str, arguments: list[str], pass_fds: Sequence[int] = ()) -> Child:
+def _launch(
+    out_dir: Path,
+    name: str,
+    arguments: list[str],
+    pass_fds: Sequence[int],
+    forked_main: Callable[[list[str]], int] | None,
+) -> Child:
+    """Start the ground station or a vehicle (``name``) with ``arguments``: forked to run
+    ``forked_main``, or, without one, as ``python -m <its package>``."""
     log = out_dir / f"{name}.log"
+    if forked_main is not None:
+        forked = start_forked(forked_main, arguments, log, pass_fds, child_environment())
+        return Child(name, forked, log)
+    module = "ground_station" if name == "ground_station" else "vehicle_sim"
     handle = log.open("w")
     process = subprocess.Popen(
-        [sys.executable, *arguments],
+        [sys.executable, "-m", module, *arguments],
         stdout=handle,
         stderr=handle,
         stdin=subprocess.DEVNULL,

@@ -58,6 +58,12 @@ def _pids(pattern: str) -> list[str]:
     ).stdout.split()
 
 
+def _children(parent: int, name: str) -> list[str]:
+    return subprocess.run(
+        ["pgrep", "-P", str(parent), "-x", name], capture_output=True, text=True
+    ).stdout.split()
+
+
 def test_a_killed_support_is_dropped_then_taken_back(scenario, tmp_path):
     out = tmp_path / "run"
     run = _start_run(scenario, out)
@@ -118,19 +124,13 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
     run = _start_run(scenario, out, "--mpc-helper")
     try:
         _wait_cycles(out, 40)
-        gcs = subprocess.run(  # the run's child (its helper has the same command line)
-            ["pgrep", "-P", str(run.pid), "-f", "--", "-m ground_station"],
-            capture_output=True,
-            text=True,
-        ).stdout.split()
+        gcs = _children(run.pid, "ground_station")
         assert len(gcs) == 1
-        helper = subprocess.run(
-            ["pgrep", "-P", gcs[0], "-x", "gcs-mpc-helper"], capture_output=True, text=True
-        ).stdout.split()
+        helper = _children(int(gcs[0]), "gcs-mpc-helper")
         assert len(helper) == 1
-        # forked from the ground station (it had one thread): its command line is the station's
-        command = Path(f"/proc/{helper[0]}/cmdline").read_bytes().split(b"\0")
-        assert command[1:3] == [b"-m", b"ground_station"]
+        # both forked (each parent had one thread): they have the run's command line
+        commands = {Path(f"/proc/{pid}/cmdline").read_bytes() for pid in (run.pid, *gcs, *helper)}
+        assert len(commands) == 1
         subprocess.run(["kill", "-9", *gcs], check=True)
         _, stderr = run.communicate(timeout=120)
     finally:

@@ -57,8 +57,8 @@ def _children_of(scenario: Path) -> list[str]:
 
 
 def _processes_of(out: Path) -> list[str]:
-    """Processes whose command line names the run's directory: the ground station, its MPC
-    helper (forked, or started with ``--for DIR``) and the vehicles (forked by the run)."""
+    """Processes whose command line names the run's directory: forked, the ground station,
+    its MPC helper and the vehicles have the run's."""
     found = subprocess.run(["pgrep", "-f", "--", str(out)], capture_output=True, text=True)
     return found.stdout.split()
 
@@ -109,8 +109,8 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert summary["scenario_source"] == str(scenario)
 
     # The same seed again, with every link signed, every MPC solved in the ground station (no
-    # helper process), and each vehicle started as `python -m vehicle_sim` instead of forked:
-    # identical results.
+    # helper process), and the station and each vehicle started as `python -m ...` instead of
+    # forked: identical results.
     key = tmp_path / "link.key"
     key.write_bytes(bytes(range(32)))
     again = _run(
@@ -121,7 +121,7 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
         "--signing-key",
         str(key),
         "--no-mpc-helper",
-        "--vehicle-start",
+        "--process-start",
         "exec",
     )
     assert again.returncode == 0, again.stderr
