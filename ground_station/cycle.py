@@ -95,7 +95,7 @@ def control_cycle(
         control.arrival_tol_m,
     )
     plans = models.planner.plan_all(
-        [support_request(state, s.name, work, models) for s in supports]
+        [s.name for s in supports], lambda name: support_request(state, name, work, models)
     )
     state.last_work_command = _reachable(
         state.xhat, work.command, control.s_max_work_m_s * control.t_cont_s

@@ -14,7 +14,7 @@ import contextlib
 import os
 import subprocess
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import BinaryIO
 
 import numpy as np
@@ -41,9 +41,12 @@ class LocalPlanner:
         self.mpc = mpc
         self.observable = observable
 
-    def plan_all(self, requests: list[PlanRequest]) -> dict[str, SupportPlan]:
-        """The plans, by support name, in the order of ``requests``."""
-        return {r.name: self.mpc.plan(r, self.observable) for r in requests}
+    def plan_all(
+        self, names: Sequence[str], request_of: Callable[[str], PlanRequest]
+    ) -> dict[str, SupportPlan]:
+        """The plans of the supports ``names``, in that order; ``request_of(name)`` builds a
+        support's problem when it is needed."""
+        return {name: self.mpc.plan(request_of(name), self.observable) for name in names}
 
     def close(self) -> None:
         """Nothing to release."""
@@ -60,12 +63,16 @@ class HelperPlanner(LocalPlanner):
         self.helper: MpcHelper | None = helper
         self._expected_ms: dict[str, float] = {}
 
-    def plan_all(self, requests: list[PlanRequest]) -> dict[str, SupportPlan]:
-        """The plans, by support name, in the order of ``requests``."""
-        theirs, ours = self._share(requests)
+    def plan_all(
+        self, names: Sequence[str], request_of: Callable[[str], PlanRequest]
+    ) -> dict[str, SupportPlan]:
+        """The plans of the supports ``names``, in that order. The helper's problems are built
+        and sent first, so it starts solving while this process builds its own."""
+        their_names, our_names = self._share(names)
+        theirs = [request_of(name) for name in their_names]
         if theirs and not self._call(lambda h: h.send(theirs)):
-            theirs, ours = [], list(requests)
-        plans = {r.name: self.mpc.plan(r, self.observable) for r in ours}
+            theirs, our_names = [], list(names)
+        plans = {name: self.mpc.plan(request_of(name), self.observable) for name in our_names}
         if theirs:
             answer = self._call(lambda h: h.receive())
             if answer is None:
@@ -76,24 +83,24 @@ class HelperPlanner(LocalPlanner):
                 plans.update((request.name, plan) for request, plan in zip(theirs, answer))
         for name, plan in plans.items():
             self._expected_ms[name] = plan.solve_ms
-        return {r.name: plans[r.name] for r in requests}
+        return {name: plans[name] for name in names}
 
-    def _share(self, requests: list[PlanRequest]) -> tuple[list[PlanRequest], list[PlanRequest]]:
-        """(the helper's requests, this process's): longest expected first, each to the side
-        with less to do; nothing for the helper when it is gone or there is one request."""
-        if self.helper is None or len(requests) < 2:
-            return [], list(requests)
-        expected = {r.name: self._expected_ms.get(r.name, 1.0) for r in requests}
-        theirs: list[PlanRequest] = []
-        ours: list[PlanRequest] = []
+    def _share(self, names: Sequence[str]) -> tuple[list[str], list[str]]:
+        """(the helper's supports, this process's): longest expected first, each to the side
+        with less to do; nothing for the helper when it is gone or there is one support."""
+        if self.helper is None or len(names) < 2:
+            return [], list(names)
+        expected = {name: self._expected_ms.get(name, 1.0) for name in names}
+        theirs: list[str] = []
+        ours: list[str] = []
         theirs_ms = ours_ms = 0.0
-        for request in sorted(requests, key=lambda r: -expected[r.name]):
+        for name in sorted(names, key=lambda n: -expected[n]):
             if not theirs or theirs_ms < ours_ms:  # ties stay here: no round trip
-                theirs.append(request)
-                theirs_ms += expected[request.name]
+                theirs.append(name)
+                theirs_ms += expected[name]
             else:
-                ours.append(request)
-                ours_ms += expected[request.name]
+                ours.append(name)
+                ours_ms += expected[name]
         return theirs, ours
 
     def _call(self, action):

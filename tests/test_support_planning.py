@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -68,8 +69,8 @@ def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along
     try:
         for index in (2, 6, 9):
             requests = _requests(along_world, local.mpc, index)
-            expected = local.plan_all(requests)
-            got = shared.plan_all(requests)
+            expected = local.plan_all(*_lazily(requests))
+            got = shared.plan_all(*_lazily(requests))
             assert list(got) == [r.name for r in requests]
             assert all(_same(got[name], expected[name]) for name in expected)
         assert shared.helper is not None  # it was used throughout, not dropped
@@ -85,7 +86,7 @@ def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, mon
         helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
         shared = HelperPlanner(local.mpc, local.observable, helper)
         try:
-            shared.plan_all(_requests(along_world, local.mpc, 2))  # numpy and casadi loaded
+            shared.plan_all(*_lazily(_requests(along_world, local.mpc, 2)))  # numpy, casadi in
             return len(os.listdir(f"/proc/{helper.process.pid}/task"))
         finally:
             shared.close()
@@ -113,15 +114,15 @@ def test_a_dead_helpers_share_is_solved_here(along_world, local, capfd):
     helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
     shared = HelperPlanner(local.mpc, local.observable, helper)
     requests = _requests(along_world, local.mpc, 4)
-    shared.plan_all(requests)  # the helper answered once
+    shared.plan_all(*_lazily(requests))  # the helper answered once
     helper.process.kill()
     helper.process.wait()
-    got = shared.plan_all(requests)
-    expected = local.plan_all(requests)
+    got = shared.plan_all(*_lazily(requests))
+    expected = local.plan_all(*_lazily(requests))
     assert all(_same(got[name], expected[name]) for name in expected)
     assert shared.helper is None
     assert "MPC helper stopped" in capfd.readouterr().err
-    shared.plan_all(requests)  # and it goes on without one
+    shared.plan_all(*_lazily(requests))  # and it goes on without one
     shared.close()
 
 
@@ -129,12 +130,8 @@ def test_the_longest_expected_solve_goes_to_the_helper_the_rest_balance(local):
     shared = HelperPlanner(local.mpc, local.observable, helper=None)  # type: ignore[arg-type]
     shared.helper = object()  # a stand-in: only the sharing is under test
 
-    def named(*names: str) -> list[PlanRequest]:
-        return [PlanRequest(n, *[None] * 7, False) for n in names]  # type: ignore[arg-type]
-
     def share(*names: str) -> tuple[list[str], list[str]]:
-        theirs, ours = shared._share(named(*names))
-        return [r.name for r in theirs], [r.name for r in ours]
+        return shared._share(names)
 
     assert share("a", "b", "c") == (["a"], ["b", "c"])  # no history: the first goes out
     assert share("a") == ([], ["a"])  # one solve: no round trip
@@ -144,3 +141,42 @@ def test_the_longest_expected_solve_goes_to_the_helper_the_rest_balance(local):
     assert share("a", "b", "c", "d") == (["a", "d"], ["b", "c"])  # 7 ms each
     shared.helper = None
     assert share("a", "b") == ([], ["a", "b"])
+
+
+def test_the_helpers_problems_are_sent_before_this_process_builds_its_own(along_world, local):
+    requests = {r.name: r for r in _requests(along_world, local.mpc, 6)}
+    events: list[str] = []
+
+    class RecordingHelper:  # answers with the plans this process would make
+        def send(self, batch):
+            events.append("send " + ",".join(r.name for r in batch))
+            self.answer = [local.mpc.plan(r, local.observable) for r in batch]
+
+        def receive(self):
+            events.append("receive")
+            return self.answer
+
+    shared = HelperPlanner(local.mpc, local.observable, helper=RecordingHelper())  # type: ignore[arg-type]
+    shared._expected_ms = {"support-1": 1.0, "support-2": 9.0, "support-3": 2.0}
+
+    def request_of(name: str) -> PlanRequest:
+        events.append("build " + name)
+        return requests[name]
+
+    plans = shared.plan_all(list(requests), request_of)
+    assert events == [
+        "build support-2",
+        "send support-2",
+        "build support-3",
+        "build support-1",
+        "receive",
+    ]
+    assert list(plans) == ["support-1", "support-2", "support-3"]  # in the order asked
+    expected = local.plan_all(*_lazily(list(requests.values())))
+    assert all(_same(plans[name], expected[name]) for name in expected)
+
+
+def _lazily(requests: list[PlanRequest]) -> tuple[list[str], Callable[[str], PlanRequest]]:
+    """plan_all's arguments for ready-made requests."""
+    by_name = {r.name: r for r in requests}
+    return list(by_name), by_name.__getitem__
