@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import signal
 import struct
 import subprocess
 import sys
@@ -285,3 +288,63 @@ def test_an_observer_sees_every_vehicle_without_disturbing_the_run(scenario, tmp
     for system in (2, 3, 4):
         assert {"HEARTBEAT", "GPS_RAW_INT", "LANDING_TARGET", "GLOBAL_POSITION_INT"} <= seen[system]
     assert _children_of(scenario) == []
+
+
+def _start_in_own_group(out: Path) -> subprocess.Popen:
+    """`mission run along` in a process group of its own, as a terminal would start it."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "mission", "run", "along", "--out", str(out), "--mpc-helper"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+        start_new_session=True,
+    )
+
+
+def _wait_for_cycles(out: Path, cycles: int, timeout_s: float = 120.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    records = out / "records.jsonl"
+    while not (records.exists() and len(records.read_text().splitlines()) >= cycles):
+        assert time.monotonic() < deadline, "the run did not get going"
+        time.sleep(0.05)
+
+
+def _gone(out: Path, timeout_s: float = 15.0) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while _processes_of(out) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return _processes_of(out) == []
+
+
+def test_ctrl_c_stops_every_process_of_a_run_and_keeps_its_logs(tmp_path):
+    """Ctrl-C reaches the run's whole process group: the ground station, its forked helper
+    and the forked vehicles all end, and the run says it was interrupted."""
+    out = tmp_path / "interrupted"
+    run = _start_in_own_group(out)
+    try:
+        _wait_for_cycles(out, 5)
+        assert len(_processes_of(out)) == 7  # run, station, helper, four vehicles
+        os.killpg(run.pid, signal.SIGINT)
+        stdout, stderr = run.communicate(timeout=60)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    assert run.returncode == 130 and "interrupted" in stdout + stderr
+    assert _gone(out)
+    assert (out / "gcs.tlog").stat().st_size > 0 and "steps to t=" in (out / "work.log").read_text()
+
+
+def test_a_killed_run_takes_its_processes_with_it(tmp_path):
+    """SIGKILL gives the run no chance to stop anything: its children notice their parent's
+    death (and the helper its station's) and end by themselves."""
+    out = tmp_path / "killed-run"
+    run = _start_in_own_group(out)
+    try:
+        _wait_for_cycles(out, 5)
+        run.kill()
+        run.wait(timeout=30)
+        assert _gone(out)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(run.pid, signal.SIGKILL)
