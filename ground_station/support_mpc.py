@@ -182,7 +182,6 @@ class SupportMpc:
         half = int(np.ceil(reach / grid.voxel_m))
         self.window = tuple(min(2 * half + 1, n) for n in grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
-        self._library_dir: tempfile.TemporaryDirectory | None = None  # only if uncacheable
         self._solver, self._cost = self._build()
         cube = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=3)))
         cube = cube[np.any(cube != 0, axis=1)]
@@ -261,23 +260,22 @@ class SupportMpc:
         )
         constraints = ca.vertcat(*steps, terminal_sq, *shadow)
         nlp = {"x": ca.vec(v), "p": parameters, "f": cost, "g": constraints}
-        library = compiled_nlp("support_mpc", nlp, IPOPT_OPTIONS, self._private_library_dir)
-        solver = ca.nlpsol(
-            "support_mpc", "ipopt", nlp if library is None else library, IPOPT_OPTIONS
-        )
+        with contextlib.ExitStack() as scratch:  # for a library the cache cannot take
+
+            def private_directory() -> str:
+                return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
+
+            library = compiled_nlp("support_mpc", nlp, IPOPT_OPTIONS, private_directory)
+            solver = ca.nlpsol(
+                "support_mpc", "ipopt", nlp if library is None else library, IPOPT_OPTIONS
+            )
+        # casadi has loaded the library: its file may go (no clean-up left for the exit, which
+        # a forked helper makes with os._exit)
         unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
         return (
             BufferedFunction(solver, ("x", "f"), unbounded),
             BufferedFunction(cost_function, ("f",)),
         )
-
-    def _private_library_dir(self) -> str:
-        """A directory for the compiled NLP that lives as long as this MPC."""
-        if self._library_dir is None:
-            self._library_dir = tempfile.TemporaryDirectory(
-                prefix="support-mpc-", ignore_cleanup_errors=True
-            )
-        return self._library_dir.name
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(corner of the window in world coordinates, the values the NLP takes there: G's

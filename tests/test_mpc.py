@@ -227,6 +227,40 @@ def test_building_the_mpc_leaves_no_files_in_the_working_directory(
     assert list(tmp_path.iterdir()) == []
 
 
+def test_an_mpc_compiled_outside_the_cache_leaves_no_files_behind(
+    along_world, tmp_path, monkeypatch
+):
+    """Where the cache cannot be written, the library is compiled into a scratch directory
+    that is gone once casadi has loaded it (a forked helper ends with os._exit: no clean-up
+    at exit), and the solver still solves."""
+    import tempfile
+
+    blocker = tmp_path / "not-a-directory"
+    blocker.write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    control = along_world.scenario.control
+    mpc = SupportMpc(control, along_world.map_grid(), along_world.camera)
+    assert list(scratch.iterdir()) == []
+    if not _has_compiler():
+        return
+    plan = read_plan(along_world.scenario)
+    work = predict_work(
+        plan.work[3], 4, plan.work, control.horizon_steps, control.d_max_work_m, 0.1
+    )
+    result = mpc.solve(
+        plan.supports[0][3],
+        plan.supports[0],
+        work.path,
+        work.indices,
+        along_world.sigma0_map().sigma_m,
+        along_world.camera.observable,
+    )
+    assert result.status in CONVERGED
+
+
 def _tiny_solver():
     """A two-variable NLP: min (x - p)^2 + (y - 2p)^2 with x + y >= 1, solved by IPOPT."""
     import casadi as ca
