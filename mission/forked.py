@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -46,6 +47,8 @@ class ForkedProcess:
     def __init__(self, pid: int) -> None:
         self.pid = pid
         self.returncode: int | None = None
+        self._pidfd: int | None = None  # readable once the child has exited (Linux 5.3+)
+        self._pidfd_tried = False
 
     def poll(self) -> int | None:
         """The exit status (negative: the signal that ended it), or None while it runs."""
@@ -53,16 +56,33 @@ class ForkedProcess:
             pid, status = os.waitpid(self.pid, os.WNOHANG)
             if pid == self.pid:
                 self.returncode = os.waitstatus_to_exitcode(status)
+                if self._pidfd is not None:
+                    os.close(self._pidfd)
+                    self._pidfd = None
         return self.returncode
 
     def wait(self, timeout: float | None = None) -> int:
-        """Wait for the exit status; ``subprocess.TimeoutExpired`` after ``timeout`` s."""
+        """Wait for the exit status; ``subprocess.TimeoutExpired`` after ``timeout`` s. The
+        wait sleeps on a pidfd where there is one (no polling: a supervisor waking every
+        few ms would take CPU from the run it supervises), else polls every POLL_S."""
         deadline = None if timeout is None else time.monotonic() + timeout
         while (code := self.poll()) is None:
-            if deadline is not None and time.monotonic() >= deadline:
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
                 raise subprocess.TimeoutExpired(f"forked child {self.pid}", timeout or 0.0)
-            time.sleep(POLL_S)
+            descriptor = self._exit_descriptor()
+            if descriptor is None:
+                time.sleep(POLL_S if left is None else min(POLL_S, left))
+            else:
+                select.select([descriptor], [], [], left)
         return code
+
+    def _exit_descriptor(self) -> int | None:
+        if not self._pidfd_tried and hasattr(os, "pidfd_open"):
+            self._pidfd_tried = True
+            with contextlib.suppress(OSError):  # an older kernel: poll instead
+                self._pidfd = os.pidfd_open(self.pid)
+        return self._pidfd
 
     def send_signal(self, number: int) -> None:
         """Signal the child unless it has been waited for (its pid may be reused)."""

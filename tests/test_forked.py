@@ -105,6 +105,18 @@ def test_a_forked_child_is_waited_for_terminated_and_killed_as_popen_would(tmp_p
     assert stubborn.wait(timeout=30) == -signal.SIGKILL
 
 
+def test_without_a_pidfd_the_wait_polls_to_the_same_effect(tmp_path, monkeypatch):
+    def no_pidfd(pid: int, flags: int = 0) -> int:
+        raise OSError("pidfd_open: not on this kernel")
+
+    monkeypatch.setattr(os, "pidfd_open", no_pidfd, raising=False)
+    child = start_forked(_sleep, [], tmp_path / "sleep.log")
+    with pytest.raises(subprocess.TimeoutExpired):
+        child.wait(timeout=0.05)
+    child.kill()
+    assert child.wait(timeout=30) == -signal.SIGKILL
+
+
 def _ignore_term_and_sleep(argv: list[str]) -> int:
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     time.sleep(60)
