@@ -2,11 +2,12 @@
 instead of starting a new interpreter, so it skips Python's start-up and every import this
 process has already made.
 
-``mission run`` starts its four vehicles this way once it has imported their code: the four
-imports of numpy, pymavlink and the simulator (~0.25 s of CPU each) become one, on a machine
-whose two cores the six processes of a run share while they set up. A forked child is a
-process like any other (its own pid, sockets and log; signals and exit statuses as with
-``subprocess.Popen``); only its command line is its parent's.
+``mission run`` starts the ground station and, once it has imported their code, the four
+vehicles this way, and the ground station its MPC helper: the imports of numpy, pymavlink and
+the simulator (~0.25 s of CPU each) are made once, not six times, on a machine whose two cores
+the processes of a run share while they set up. A forked child is a process like any other
+(its own pid, sockets and log; signals and exit statuses as with ``subprocess.Popen``); only
+its command line is its parent's.
 
 A fork copies just the calling thread, so a lock another thread holds (in malloc, a logging
 handler, a BLAS pool) would stay held in the child: :func:`fork_is_safe` allows it only while
