@@ -256,7 +256,6 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     core for it); and the wall time of the full Table 3 batch, estimated as trials x (sum of
     one run per scenario and method, made as the batch makes them) / jobs."""
     import tempfile
-    from pathlib import Path
 
     from mission.batch import helper_has_a_core
 
