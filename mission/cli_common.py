@@ -61,26 +61,32 @@ def freeze_startup_heap() -> None:
     gc.freeze()
 
 
-def name_this_process(name: str) -> None:
-    """Set the name ``ps -o comm``, ``top`` and ``pgrep NAME`` show (Linux; 15 bytes at most,
-    longer names are cut); no-op elsewhere."""
+PR_SET_PDEATHSIG = 1  # prctl options (linux/prctl.h)
+PR_SET_NAME = 15
+
+
+def _prctl(option: int, value: int | bytes) -> None:
+    """Linux's prctl(option, value); nothing elsewhere or where libc will not say."""
     import contextlib
     import ctypes
 
     if sys.platform.startswith("linux"):
         with contextlib.suppress(OSError, AttributeError):
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(15, name.encode()[:15], 0, 0, 0)
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(option, value, 0, 0, 0)
+
+
+def name_this_process(name: str) -> None:
+    """Set the name ``ps -o comm``, ``top`` and ``pgrep NAME`` show (Linux; 15 bytes at most,
+    longer names are cut); no-op elsewhere."""
+    _prctl(PR_SET_NAME, name.encode()[:15])
 
 
 def die_with_parent() -> None:
     """Ask Linux to send SIGTERM when the parent process dies (no orphans); no-op elsewhere."""
-    import contextlib
-    import ctypes
     import signal
 
     if sys.platform.startswith("linux"):
-        with contextlib.suppress(OSError, AttributeError):
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)
+        _prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
         parent = os.environ.get(PARENT_PID_VARIABLE)
         if parent is not None and parent.isdigit() and os.getppid() != int(parent):
             os.kill(os.getpid(), signal.SIGTERM)  # the parent died before prctl took effect
