@@ -256,6 +256,7 @@ class ControlSettings:
     arrival_tol_m: float
     support_max_sigma0_m: float
     los_penalty: Literal["visible-point", "paper"]
+    mpc_solver: Literal["fatrop", "ipopt"]
 
     def __post_init__(self) -> None:
         _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
