@@ -86,6 +86,13 @@ BAD_INPUTS = [
     ("negative voxel", "map: {voxel_size_m: -1}\n", "map.voxel_size_m", "must be positive"),
     ("eta above one", "map: {eta: 1.5}\n", "map.eta", "must be in [0, 1]"),
     (
+        "infinite bound",  # an MPC constraint's bound: fatrop needs it finite
+        "control: {support_max_sigma0_m: .inf}\n",
+        "control.support_max_sigma0_m",
+        "must be finite",
+    ),
+    ("unknown solver", "control: {mpc_solver: snopt}\n", "control.mpc_solver", "snopt"),
+    (
         "integer field",
         "fusion: {broad_particles: 2.5}\n",
         "fusion.broad_particles",

@@ -6,11 +6,12 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
+from ground_station.support_mpc import CONVERGED, PlanRequest, SupportMpc, SupportPlan
 from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
 from ground_station.work_mpc import predict_work
 from mission.plan_files import read_plan
@@ -80,6 +81,21 @@ def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="needs /proc")
+def test_a_plan_does_not_depend_on_the_solves_before_it(along_world, local):
+    """The helper's bit-for-bit promise needs solves without memory: the same problems
+    planned in the opposite order give the same plans, bit for bit. (fatrop fed an infinite
+    constraint bound carried its failure into later solves; no bound is infinite now.)"""
+    requests = [r for index in (2, 6, 9) for r in _requests(along_world, local.mpc, index)]
+    requests += [  # out of reach of the terminal waypoint: the far branch alone
+        replace(r, yhat=r.yhat + [7.0, 0.0, 0.0]) for r in _requests(along_world, local.mpc, 4)
+    ]
+    forward = [local.mpc.plan(r, local.observable) for r in requests]
+    backward = [local.mpc.plan(r, local.observable) for r in reversed(requests)][::-1]
+    assert all(_same(a, b) for a, b in zip(forward, backward, strict=True))
+    assert sum(plan.status == CONVERGED for plan in forward) == len(requests)
+    assert all(np.isfinite(bounds).all() for bounds in local.mpc._upper_bounds.values())
+
+
 def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, monkeypatch):
     def threads_after_a_plan() -> int:
         helper = MpcHelper(fork=False)  # a fresh interpreter: its BLAS reads the environment
