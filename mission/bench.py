@@ -187,7 +187,8 @@ def bench_ground_station(
 
 
 def _scipy_over_casadi(world, plan, problems: int) -> float:
-    """Median time ratio SLSQP / IPOPT on the same support-MPC problems (optima within 1 cm)."""
+    """Median time ratio SLSQP / our solver on the same support-MPC problems (optima within
+    1 cm)."""
     import numpy as np
     from scipy.optimize import minimize
 

@@ -157,7 +157,7 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting, offset):
     np.testing.assert_allclose(reference.x.reshape(-1, 3), result.path, atol=0.01)
     ours = cost(result.path.ravel())
     assert ours == pytest.approx(reference.fun, rel=1e-5)
-    assert ours <= reference.fun * (1 + 1e-7)  # IPOPT's optimum is at least as good
+    assert ours <= reference.fun * (1 + 1e-7)  # our optimum is at least as good
 
 
 def test_the_far_branch_is_skipped_only_where_it_cannot_win(setting, monkeypatch):
