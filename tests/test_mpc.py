@@ -340,6 +340,46 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
     np.testing.assert_allclose(solved, expected, atol=1e-4)
 
 
+def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkeypatch):
+    import subprocess
+
+    import casadi as ca
+
+    from ground_station import support_mpc
+
+    if not _has_compiler():
+        return
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    nlp, options = _tiny_solver()
+    shifted = {**nlp, "f": nlp["f"] + nlp["x"][1]}
+    scaled = {**nlp, "f": 2 * nlp["f"]}
+    launched: list[subprocess.Popen] = []
+    popen = subprocess.Popen
+
+    def counting(*args, **kwargs):
+        launched.append(popen(*args, **kwargs))
+        return launched[-1]
+
+    monkeypatch.setattr(support_mpc.subprocess, "Popen", counting)
+
+    def builds(*nlps):
+        return [support_mpc.NlpBuild("tiny", "ipopt", n, options) for n in nlps]
+
+    def no_fallback() -> str:
+        raise AssertionError("the cache is writable: no fallback directory")
+
+    first = support_mpc.compiled_nlps(builds(nlp, shifted), no_fallback)
+    assert len(launched) == 2 and all(p.returncode == 0 for p in launched)
+    assert None not in first and len(set(first)) == 2
+    again = support_mpc.compiled_nlps(builds(nlp, scaled, shifted), no_fallback)
+    assert len(launched) == 3  # only the new one compiled
+    assert (again[0], again[2]) == (first[0], first[1]) and again[1] not in first
+    cache = tmp_path / "cache" / "bridge-uav-formation"
+    assert sorted(path.name for path in cache.iterdir()) == sorted(Path(f).name for f in again)
+    solved = ca.nlpsol("tiny", "ipopt", again[1], options)(x0=[0, 0], p=1.5, lbg=1.0)["x"]
+    np.testing.assert_allclose(solved, [[1.5], [3.0]], atol=1e-4)  # 2x the cost: same optimum
+
+
 def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monkeypatch):
     import casadi as ca
 
