@@ -111,6 +111,27 @@ def test_zone_offset_applies_inside_the_zone_only(along_world):
     np.testing.assert_allclose(fixes.mean(axis=0), inside + zone.offset_m, atol=0.05)
 
 
+def test_one_point_and_many_points_find_the_same_zone(along_world):
+    """A vehicle asks one point a step (a plain-float path); batches use numpy. Points on the
+    faces count as inside, NaN as outside, either way."""
+    zone = along_world.scenario.world.zones[0]
+    lo, hi = np.array(zone.min_m), np.array(zone.max_m)
+    rng = np.random.default_rng(4)
+    points = np.vstack(
+        [
+            rng.uniform([-25, -20, 0], [25, 20, 20], (3000, 3)),
+            rng.uniform(lo - 0.5, hi + 0.5, (3000, 3)),
+            [lo, hi, np.nextafter(lo, -np.inf), [np.nan, lo[1], lo[2]]],
+        ]
+    )
+    batch = along_world.zone_offset(points)
+    one_by_one = np.vstack([along_world.zone_offset(point[None]) for point in points])
+    np.testing.assert_array_equal(one_by_one, batch)
+    assert 500 < (batch[:, 0] != 0).sum() < 3000  # both kinds, many of each
+    np.testing.assert_array_equal(batch[-4:-2], [zone.offset_m] * 2)
+    np.testing.assert_array_equal(batch[-2:], 0.0)
+
+
 def test_reported_accuracy_ignores_the_multipath_offset(along_world):
     """A receiver does not know its bias: reported DOP is the same with or without offset."""
     rng = np.random.default_rng(1)
