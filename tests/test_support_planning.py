@@ -96,6 +96,26 @@ def test_a_plan_does_not_depend_on_the_solves_before_it(along_world, local):
     assert all(np.isfinite(bounds).all() for bounds in local.mpc._upper_bounds.values())
 
 
+def test_ipopt_plans_as_fatrop_does(along_world, local, monkeypatch):
+    """``mpc_solver: ipopt`` (what MODEL.md names) still works and finds the same optima:
+    fatrop runs the same algorithm (interpreted here: the test compiles nothing more)."""
+    from dataclasses import replace as replaced
+
+    from ground_station import support_mpc
+
+    monkeypatch.setattr(support_mpc, "compiled_nlps", lambda builds, _: [None] * len(builds))
+    control = replaced(along_world.scenario.control, mpc_solver="ipopt")
+    ipopt = SupportMpc(
+        control, along_world.map_grid(), along_world.camera, along_world.sigma0_map().sigma_m
+    )
+    requests = [r for index in (2, 6, 9) for r in _requests(along_world, local.mpc, index)]
+    for request in requests:
+        ours = local.mpc.plan(request, local.observable)
+        theirs = ipopt.plan(request, local.observable)
+        assert (ours.status, theirs.status) == (CONVERGED, CONVERGED)
+        np.testing.assert_allclose(theirs.path, ours.path, atol=1e-3)
+
+
 def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, monkeypatch):
     def threads_after_a_plan() -> int:
         helper = MpcHelper(fork=False)  # a fresh interpreter: its BLAS reads the environment
