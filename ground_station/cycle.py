@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -74,9 +75,17 @@ class CycleOutput:
 
 
 def control_cycle(
-    state: StationState, supports: list[SupportMeasurement], models: Models
+    state: StationState,
+    supports: list[SupportMeasurement],
+    models: Models,
+    work_ready: Callable[[np.ndarray, int | None], None] | None = None,
 ) -> CycleOutput:
-    """One control cycle; updates ``state`` in place and returns the commands."""
+    """One control cycle; updates ``state`` in place and returns the commands.
+
+    ``work_ready(command, reached)`` is called as soon as the work UAV's command (and the
+    waypoint it reached, if any) is known, before the support MPCs are solved: the ground
+    station sends it at once, and the work vehicle steps while they are solved.
+    """
     start = time.perf_counter()
     control = models.scenario.control
     fusion = fuse(state, supports, models)  # steps 1-2
@@ -94,6 +103,8 @@ def control_cycle(
         control.d_max_work_m,
         control.arrival_tol_m,
     )
+    if work_ready is not None:
+        work_ready(work.command, arrived)
     plans = models.planner.plan_all(
         [s.name for s in supports], lambda name: support_request(state, name, work, models)
     )

@@ -6,6 +6,7 @@ epoch; the per-cycle record and snapshots of G are written alongside as the run 
 
 from __future__ import annotations
 
+import functools
 import json
 import socket
 import sys
@@ -150,10 +151,13 @@ class GroundStation:
         """Each vehicle's queued packets out, in order, in one datagram (commands and tick
         wake a vehicle once, not three times)."""
         for view in self.views.values():
-            if view.outbox:
-                self.endpoint.send_packets([packet for _, packet in view.outbox], [view.address])
-                view.last_batch = [message for message, _ in view.outbox]
-                view.outbox = []
+            self._flush(view)
+
+    def _flush(self, view: VehicleView) -> None:
+        if view.outbox:
+            self.endpoint.send_packets([packet for _, packet in view.outbox], [view.address])
+            view.last_batch = [message for message, _ in view.outbox]
+            view.outbox = []
 
     def _log_received(self, message: Any, sender: Address) -> None:
         view = self.by_system.get(message.get_srcSystem())
@@ -278,11 +282,13 @@ class GroundStation:
                 self.world,
                 self.frame,
             )
-            output = control_cycle(state, measurements, models)
-            self._command(state, output)
+            work_step: list[PendingStep | None] = []
+            send_work = functools.partial(self._command_work_first, state, work_step)
+            output = control_cycle(state, measurements, models, send_work)
+            self._command_supports(state, output)
             cycle_time_s = self.sim_time_s
             # the next tick goes out now: the vehicles step while this cycle is written down
-            pending = None if state.completed else self._tick()
+            pending = None if state.completed else self._tick(*work_step)
             self.flush_outboxes()
             self._record(state, output, cycle_time_s)
             self.cycles += 1
@@ -325,21 +331,31 @@ class GroundStation:
         )
         return self.models, state
 
-    def _tick(self) -> PendingStep | None:
-        """Start the next step (None once the scenario's timeout is reached): in lockstep,
-        advance the clock and queue every vehicle's tick after its commands; in real time the
-        step just runs."""
+    def _next_step(self) -> PendingStep | None:
+        """The next step, not started yet (None once the scenario's timeout is reached); in
+        lockstep with the tick that will start it."""
         step = self.scenario.control.t_cont_s
         if self.sim_time_s >= self.scenario.run.timeout_s - 1e-9:
             return None
         if self.config.speedup is not None:
             return PendingStep(step)
         target_ms = round((self.sim_time_s + step) * 1000)
-        self.sim_time_s = target_ms / 1000.0
-        tick = mavlink2.MAVLink_system_time_message(self.time_usec, target_ms)
+        usec = round((self.scenario.run.epoch_unix_s + target_ms / 1000.0) * 1e6)
+        return PendingStep(step, mavlink2.MAVLink_system_time_message(usec, target_ms))
+
+    def _tick(self, work_step: PendingStep | None = None) -> PendingStep | None:
+        """Start the next step (None once the scenario's timeout is reached): in lockstep,
+        advance the clock and queue every vehicle's tick after its commands (the work
+        vehicle's only if it was not sent with its commands: ``work_step``); in real time the
+        step just runs."""
+        pending = self._next_step() if work_step is None else work_step
+        if pending is None or pending.tick is None:
+            return pending
+        self.sim_time_s = pending.tick.time_boot_ms / 1000.0
         for view in self.views.values():
-            self.queue_for(tick, view)
-        return PendingStep(step, tick)
+            if work_step is None or view.name != "work":
+                self.queue_for(pending.tick, view)
+        return pending
 
     def _await_step(self, pending: PendingStep) -> None:
         """Lockstep: wait for every vehicle's telemetry of the step, sending the tick again to
@@ -413,18 +429,35 @@ class GroundStation:
                 return None
         return message
 
-    def _command(self, state: StationState, output: CycleOutput) -> None:
+    def _command_work_first(
+        self,
+        state: StationState,
+        started: list[PendingStep | None],
+        command: np.ndarray,
+        reached: int | None,
+    ) -> None:
+        """Send the work vehicle its estimate, setpoint (the next mission item once a waypoint
+        is reached) and, unless the mission is complete, the next step's tick, before the
+        support MPCs are solved: it steps meanwhile, and its truth is there when the supports
+        step. The step its tick starts (None: no tick went out) goes into ``started``."""
         work = self.views["work"]
         self._estimate(state.xhat, work)
-        self._setpoint(output.work_target, work)
-        for name, target in output.support_targets.items():
-            self._estimate(state.yhat[name], self.views[name])
-            self._setpoint(target, self.views[name])
-        if output.arrived is not None and not state.completed:
+        self._setpoint(command, work)
+        if reached is not None and not state.completed:
             self.queue_for(
                 mavlink2.MAVLink_mission_set_current_message(work.system_id, 1, state.k + 1), work
             )
-            self._announce(f"Work UAV reached waypoint {output.arrived + 1}")
+            self._announce(f"Work UAV reached waypoint {reached + 1}")
+        step = None if state.completed else self._next_step()
+        if step is not None and step.tick is not None:
+            self.queue_for(step.tick, work)
+        self._flush(work)
+        started.append(step)
+
+    def _command_supports(self, state: StationState, output: CycleOutput) -> None:
+        for name, target in output.support_targets.items():
+            self._estimate(state.yhat[name], self.views[name])
+            self._setpoint(target, self.views[name])
 
     def _estimate(self, position: np.ndarray, view: VehicleView) -> None:
         n, e, d = (float(v) for v in enu_to_ned(position))

@@ -127,6 +127,17 @@ def test_a_short_mission_completes_and_is_logged(short_scenario, tmp_path):
         ticks += message.get_srcSystem() == 255
     resends = json.loads((tmp_path / "link.json").read_text())["tick_resends"]
     assert ticks == 4 * summary["control_cycles"] + resends
+    # The work vehicle's setpoint and tick leave before the support MPCs are solved (it steps
+    # meanwhile): the packet after its setpoint is its tick, not a support's setpoint.
+    log = mavutil.mavlink_connection(str(tmp_path / "gcs.tlog"), dialect="ardupilotmega")
+    sent = []
+    kinds = ["SET_POSITION_TARGET_LOCAL_NED", "SYSTEM_TIME"]
+    while (message := log.recv_match(type=kinds)) is not None:
+        if message.get_srcSystem() == 255:
+            sent.append("tick" if message.get_type() == "SYSTEM_TIME" else message.target_system)
+    after_work = [sent[i + 1] for i, item in enumerate(sent[:-1]) if item == 1]
+    assert len(after_work) == summary["control_cycles"]
+    assert after_work == ["tick"] * (len(after_work) - 1) + [2]  # the last cycle: no tick
 
 
 def test_mavlogdump_reads_the_tlog_and_nac_leaves_g(short_scenario, tmp_path):
