@@ -124,6 +124,30 @@ def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout()
     assert "truth waits timed out 1, stale truth 1" in report
 
 
+def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has():
+    """Truth samples come in order: once a later one is there, the truth of the step was lost
+    or came before the support listened (a support restarted into a running mission), and
+    waiting for it would only stall the support for the timeout at every such step."""
+    import numpy as np
+
+    from mission.scenario import load_scenario
+    from vehicle_sim.truth_link import TruthSender
+
+    timeout = load_scenario("along").vehicle.truth_timeout_wall_s
+    with vehicle_process("support-1") as support:
+        assert support.truth_port is not None
+        truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
+        client = MavClient(support.address)
+        truth.publish(np.array([0.0, -4.0, 7.0]), 1000)  # the next step's truth, not this one's
+        time.sleep(0.3)  # it has arrived
+        assert _step_marker_after(client, 500) < 0.5 * timeout
+        assert _step_marker_after(client, 1000) < 0.5 * timeout  # its own truth: no wait either
+        truth.close()
+        client.close()
+        report = support.stop()
+    assert "truth waits timed out 0, stale truth 1" in report
+
+
 def mavlink2_tick(time_ms: int):
     """The ground station's lockstep tick to ``time_ms``."""
     from pymavlink.dialects.v20 import ardupilotmega as mavlink2

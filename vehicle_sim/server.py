@@ -237,7 +237,11 @@ class VehicleServer:
             return True
         self.truth_receiver.drain()
         truth = self.truth_receiver.exact(vehicle.time_boot_ms)
-        if truth is None and self.clock.lockstep and self.truth_receiver.samples:
+        if (
+            truth is None
+            and self.clock.lockstep
+            and self.truth_receiver.may_still_come(vehicle.time_boot_ms)
+        ):
             timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
             self._pending_deadline = now + timeout
             return False
@@ -250,10 +254,11 @@ class VehicleServer:
         vehicle, receiver = self.vehicle, self.truth_receiver
         assert vehicle is not None and receiver is not None and self._pending_deadline is not None
         truth = receiver.exact(vehicle.time_boot_ms)
-        if truth is None and now < self._pending_deadline:
+        timed_out = now >= self._pending_deadline
+        if truth is None and not timed_out and receiver.may_still_come(vehicle.time_boot_ms):
             return False
-        if truth is None:
-            self.stats.truth_waits_timed_out += 1
+        if truth is None:  # a later truth came instead, or none in time
+            self.stats.truth_waits_timed_out += int(timed_out)
             truth = receiver.estimate(vehicle.time_boot_ms)
         self._pending_deadline = None
         self._publish_step(truth)

@@ -41,8 +41,11 @@ class TruthSender:
 class TruthReceiver:
     """Support side: keep the work UAV's recent true positions by simulated time.
 
-    In lockstep a support waits (briefly) for the truth of each step only once it has heard
-    from a work vehicle at all; a support running alone publishes not-valid observations.
+    In lockstep a support waits (briefly) for the truth of a step only while it may still come:
+    once it has heard from a work vehicle at all, and while nothing later has arrived (the
+    samples come in order; a later one means this one was lost, came before the support
+    listened, or was dropped from the samples kept). A support running alone publishes
+    not-valid observations.
     """
 
     def __init__(
@@ -68,6 +71,11 @@ class TruthReceiver:
             self.samples.move_to_end(int(message.time_boot_ms))
             while len(self.samples) > KEEP_SAMPLES:
                 self.samples.popitem(last=False)
+
+    def may_still_come(self, time_boot_ms: int) -> bool:
+        """Whether the truth at this time is worth waiting for: some truth has arrived, none
+        of it later than this time."""
+        return bool(self.samples) and max(self.samples) < time_boot_ms
 
     def exact(self, time_boot_ms: int) -> np.ndarray | None:
         """The truth at exactly this simulated time, if it has arrived."""
