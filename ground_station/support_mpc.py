@@ -89,17 +89,6 @@ class NlpBuild:
     options: dict
 
 
-def compiled_nlp(
-    name: str,
-    plugin: str,
-    nlp: dict[str, ca.MX],
-    options: dict,
-    fallback_dir: Callable[[], str],
-) -> str | None:
-    """The library of one NLP: see :func:`compiled_nlps`."""
-    return compiled_nlps([NlpBuild(name, plugin, nlp, options)], fallback_dir)[0]
-
-
 def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> list[str | None]:
     """For each build, the functions its casadi solver needs, compiled into a shared library
     with the system C compiler (about 1.5x faster solves than interpreting them), or None

@@ -272,6 +272,14 @@ def _tiny_solver():
     return nlp, IPOPT_OPTIONS
 
 
+def _compiled_one(name, plugin, nlp, options, fallback_dir):
+    """The library of one NLP, as ``compiled_nlps`` makes it."""
+    from ground_station import support_mpc
+
+    build = support_mpc.NlpBuild(name, plugin, nlp, options)
+    return support_mpc.compiled_nlps([build], fallback_dir)[0]
+
+
 def _has_compiler() -> bool:
     import shutil
 
@@ -294,7 +302,7 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
     def no_fallback() -> str:
         raise AssertionError("the cache is writable: no fallback directory")
 
-    first = support_mpc.compiled_nlp("tiny", "ipopt", nlp, options, no_fallback)
+    first = _compiled_one("tiny", "ipopt", nlp, options, no_fallback)
     if not _has_compiler():
         assert first is None
         return
@@ -313,7 +321,7 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
         hit.setattr(support_mpc.tempfile, "TemporaryDirectory", no_scratch)
         hit.setattr(support_mpc.ca, "nlpsol", no_solver)
         again, _ = _tiny_solver()  # the same NLP, built afresh
-        assert support_mpc.compiled_nlp("tiny", "ipopt", again, options, no_fallback) == first
+        assert _compiled_one("tiny", "ipopt", again, options, no_fallback) == first
     assert Path(first).stat().st_mtime_ns == mtime
     compiled = ca.nlpsol("tiny", "ipopt", first, options)
     expected = interpreted(x0=[0, 0], p=1.5, lbg=1.0, ubg=np.inf)["x"]
@@ -323,15 +331,15 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
     exact_only = {k: v for k, v in options.items() if k != "calc_lam_p"}
     changed = {**nlp, "f": nlp["f"] + nlp["x"][0]}
     others = [
-        support_mpc.compiled_nlp("tiny", "ipopt", changed, options, no_fallback),
-        support_mpc.compiled_nlp("tiny", "ipopt", nlp, exact_only, no_fallback),
-        support_mpc.compiled_nlp("other", "ipopt", nlp, options, no_fallback),
+        _compiled_one("tiny", "ipopt", changed, options, no_fallback),
+        _compiled_one("tiny", "ipopt", nlp, exact_only, no_fallback),
+        _compiled_one("other", "ipopt", nlp, options, no_fallback),
     ]
     assert len({first, *others}) == 4
     # Another plugin needs its own functions (fatrop's Lagrangian Hessian has other outputs).
     plain = {"print_time": False}
     by_plugin = {
-        plugin: support_mpc.compiled_nlp("tiny", plugin, nlp, plain, no_fallback)
+        plugin: _compiled_one("tiny", plugin, nlp, plain, no_fallback)
         for plugin in ("ipopt", "fatrop")
     }
     assert by_plugin["ipopt"] != by_plugin["fatrop"]
@@ -383,14 +391,12 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
 def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monkeypatch):
     import casadi as ca
 
-    from ground_station import support_mpc
-
     blocker = tmp_path / "not-a-directory"
     blocker.write_text("")
     monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
     fallback = tmp_path / "private"
     nlp, options = _tiny_solver()
-    library = support_mpc.compiled_nlp("tiny", "ipopt", nlp, options, lambda: str(fallback))
+    library = _compiled_one("tiny", "ipopt", nlp, options, lambda: str(fallback))
     if not _has_compiler():
         assert library is None
         return
