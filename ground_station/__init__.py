@@ -1,1 +1,1 @@
-"""The ground station: fusion, the GNSS-localizability map, the MPCs and the control cycle."""
+"""The ground-station process (never sees zones or truth). Imports: config, world, link, procs."""

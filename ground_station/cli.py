@@ -10,7 +10,12 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from mission.cli_common import (
+from mission.config.errors import InputError
+from mission.link.mavlink_udp import parse_address
+from mission.link.plan_files import vehicle_names
+from mission.link.signing import read_signing_key
+from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
+from mission.procs.cli_common import (
     OneLineArgumentParser,
     add_link_arguments,
     die_with_parent,
@@ -18,12 +23,7 @@ from mission.cli_common import (
     name_this_process,
     run_guarded,
 )
-from mission.errors import InputError
-from mission.mavlink_udp import parse_address
-from mission.plan_files import vehicle_names
-from mission.signing import read_signing_key
-from mission.vehicle_identity import BASE_PORT, VehicleIdentity
-from mission.world import World
+from mission.world.model import World
 
 
 def build_parser() -> OneLineArgumentParser:
@@ -91,7 +91,7 @@ def build_parser() -> OneLineArgumentParser:
 
 def read_waypoints_file(path: Path) -> None:
     """Check one vehicle's waypoint file (InputError naming the file and line)."""
-    from mission.waypoints import read_waypoints
+    from mission.link.waypoints import read_waypoints
 
     if not path.is_file():
         raise InputError(str(path), "", "no such waypoint file")

@@ -25,8 +25,8 @@ from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
 from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
 from ground_station.support_planning import LocalPlanner
 from ground_station.work_mpc import WorkPrediction, predict_work
-from mission.settings import Scenario
-from mission.world import World
+from mission.config.settings import Scenario
+from mission.world.model import World
 
 ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape starts too
 

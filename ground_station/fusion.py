@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mission.settings import FusionSettings
+from mission.config.settings import FusionSettings
 
 
 @dataclass(frozen=True)

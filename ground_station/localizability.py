@@ -14,8 +14,8 @@ import itertools
 import casadi as ca
 import numpy as np
 
-from mission.grid import VoxelGrid
-from mission.settings import MapSettings
+from mission.config.settings import MapSettings
+from mission.world.grid import VoxelGrid
 
 
 class LocalizabilityMap:

@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 
 from ground_station.fusion import SupportMeasurement
-from mission.frames import GeodeticFrame, ned_to_enu
-from mission.world import World
+from mission.world.frames import GeodeticFrame, ned_to_enu
+from mission.world.model import World
 
 MIN_3D_FIX = 3
 

@@ -8,8 +8,8 @@ from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.mavlink_udp import Address, MessageQueue
-from mission.mission_items import MISSION, MissionItem
+from mission.link.mavlink_udp import Address, MessageQueue
+from mission.link.mission_items import MISSION, MissionItem
 
 OnOther = Callable[[Any, Address], None]
 

@@ -8,7 +8,7 @@ station's), then lists of
 error text. A frame is a 4-byte big-endian length and a pickle; both ends are this program.
 The helper ends at end of input, i.e. when the ground station closes the pipe or dies.
 
-A ground station with one thread forks its helper (:mod:`mission.forked`), which then serves
+A ground station with one thread forks its helper (:mod:`mission.procs.forked`), which then serves
 two pipes (:func:`serve_descriptors`) with the station's imports already made; otherwise it
 starts ``python -m ground_station.mpc_helper``, whose ``--for LABEL`` (the station's output
 directory) only names it in ``ps``. Either way it calls itself ``gcs-mpc-helper``.
@@ -49,8 +49,8 @@ def read_frame(stream: BinaryIO) -> Any:
 def serve(requests: BinaryIO, answers: BinaryIO) -> None:
     """Build the solver from the first frame, then answer request lists until end of input."""
     from ground_station.support_mpc import SupportMpc
-    from mission.cli_common import freeze_startup_heap
-    from mission.world import World
+    from mission.procs.cli_common import freeze_startup_heap
+    from mission.world.model import World
 
     try:
         scenario, sigma0 = read_frame(requests)
@@ -88,7 +88,7 @@ def serve_descriptors(argv: list[str]) -> int:
 
 
 def _serve_quietly(requests: BinaryIO, answers: BinaryIO) -> int:
-    from mission.cli_common import name_this_process
+    from mission.procs.cli_common import name_this_process
 
     name_this_process(PROCESS_NAME)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -98,7 +98,7 @@ def _serve_quietly(requests: BinaryIO, answers: BinaryIO) -> int:
 
 
 if __name__ == "__main__":
-    from mission.math_threads import use_one_math_thread
+    from mission.procs.math_threads import use_one_math_thread
 
     use_one_math_thread()  # before serve() imports numpy
     sys.exit(main())

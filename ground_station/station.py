@@ -26,14 +26,14 @@ from ground_station.mission_client import MissionClient, MissionTransferError
 from ground_station.support_mpc import SupportMpc
 from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
 from ground_station.tlog import TlogWriter
-from mission.atomic import write_text_atomically
-from mission.cli_common import freeze_startup_heap
-from mission.frames import GeodeticFrame, enu_to_ned
-from mission.link_impairment import LinkSettings
-from mission.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
-from mission.vehicle_identity import VehicleIdentity
-from mission.waypoints import read_waypoints, row_position_enu
-from mission.world import World
+from mission.link.impairment import LinkSettings
+from mission.link.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.link.vehicle_identity import VehicleIdentity
+from mission.link.waypoints import read_waypoints, row_position_enu
+from mission.procs.atomic import write_text_atomically
+from mission.procs.cli_common import freeze_startup_heap
+from mission.world.frames import GeodeticFrame, enu_to_ned
+from mission.world.model import World
 
 GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190

@@ -42,9 +42,9 @@ import numpy as np
 
 from ground_station.casadi_buffer import BufferedFunction
 from ground_station.localizability import hermite_zero_slope, inlined_hermite
-from mission.camera import CameraModel
-from mission.grid import VoxelGrid
-from mission.settings import ControlSettings
+from mission.config.settings import ControlSettings
+from mission.world.camera import CameraModel
+from mission.world.grid import VoxelGrid
 
 IPOPT_OPTIONS = {
     "ipopt.print_level": 0,

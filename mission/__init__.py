@@ -1,1 +1,1 @@
-"""Mission layer: scenarios, world model (structure, sky, GNSS, camera), planning and runs."""
+"""Everything around the two processes, in role packages, and the CLI. Imports: all."""

@@ -10,14 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mission.cli_common import (
+from mission.config.errors import InputError
+from mission.procs.cli_common import (
     OneLineArgumentParser,
     add_link_arguments,
     link_settings,
     parse_point,
     run_guarded,
 )
-from mission.errors import InputError
 
 DEFAULT_SCENARIO = "along"
 DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
@@ -146,21 +146,21 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _world(args) -> int:
     point = parse_point(args.at, "--at") if args.at is not None else None
-    from mission.world import World
+    from mission.world.model import World
 
     if args.plot is not None:
         _check_output_path(args.plot, "--plot", ".png")
     world = World.load(args.scenario)
     if point is not None:
-        from mission.world_report import point_report
+        from mission.analysis.world_report import point_report
 
         print(json.dumps(point_report(world, np.array(point))))
     else:
-        from mission.world_report import summary_text
+        from mission.analysis.world_report import summary_text
 
         print(summary_text(world))
     if args.plot is not None:
-        from mission.world_plot import plot_world
+        from mission.analysis.world_plot import plot_world
 
         plot_world(world, np.array(point or DEFAULT_PLOT_POINT), args.plot)
     return 0
@@ -169,11 +169,11 @@ def _world(args) -> int:
 def _run(args) -> int:
     import time
 
-    from mission.orchestrator import RunFailed, RunOptions, run_mission
-    from mission.scenario import load_scenario
+    from mission.config.scenario import load_scenario
+    from mission.runs.orchestrator import RunFailed, RunOptions, run_mission
 
     if args.exit_with_parent:
-        from mission.cli_common import die_with_parent
+        from mission.procs.cli_common import die_with_parent
 
         die_with_parent()
     scenario = load_scenario(args.scenario)
@@ -183,11 +183,11 @@ def _run(args) -> int:
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
     if args.signing_key is not None:
-        from mission.signing import read_signing_key
+        from mission.link.signing import read_signing_key
 
         read_signing_key(args.signing_key)  # a bad key fails here, before anything starts
     if args.observer is not None:
-        from mission.mavlink_udp import parse_address
+        from mission.link.mavlink_udp import parse_address
 
         try:
             parse_address(args.observer, "--observer")
@@ -228,8 +228,8 @@ def _run(args) -> int:
 
 
 def _batch(args) -> int:
-    from mission.batch import BatchOptions, Trial, run_batch
-    from mission.scenario import load_scenario
+    from mission.config.scenario import load_scenario
+    from mission.runs.batch import BatchOptions, Trial, run_batch
 
     if not 1 <= args.trials <= 1000:
         raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
@@ -266,8 +266,8 @@ def _batch(args) -> int:
 
 def _preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts."""
-    from mission.plan_files import read_plan
-    from mission.structure import load_mesh_file
+    from mission.link.plan_files import read_plan
+    from mission.world.structure import load_mesh_file
 
     mesh_file = scenario.world.structure.mesh_file
     if mesh_file is not None:
@@ -276,10 +276,10 @@ def _preflight(scenario) -> None:
 
 
 def _plan(args) -> int:
-    from mission.plan_files import write_plan
-    from mission.planner import plan_supports
-    from mission.world import World
-    from mission.zone_placement import place_along, place_wall
+    from mission.link.plan_files import write_plan
+    from mission.planning.planner import plan_supports
+    from mission.planning.zone_placement import place_along, place_wall
+    from mission.world.model import World
 
     if args.plot is not None:
         _check_output_path(args.plot, "--plot", ".png")
@@ -305,15 +305,15 @@ def _plan(args) -> int:
     except (ValueError, IndexError):
         print("a Wall zone: no place on this plan")
     if args.plot is not None:
-        from mission.plan_plot import plot_plan
+        from mission.planning.plan_plot import plot_plan
 
         plot_plan(world, plan, args.plot)
     return 0
 
 
 def _analyze(args) -> int:
-    from mission.analysis import analyze_tlog
-    from mission.scenario import load_scenario
+    from mission.analysis.metrics import analyze_tlog
+    from mission.config.scenario import load_scenario
 
     tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
     if not tlog.is_file():
@@ -327,14 +327,14 @@ def _analyze(args) -> int:
     metrics = analyze_tlog(tlog, scenario)
     merged = {**previous, **metrics}
     if previous:
-        from mission.atomic import write_text_atomically
+        from mission.procs.atomic import write_text_atomically
 
         write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
     print(json.dumps(metrics))
     if args.plots:
-        from mission.analysis import read_tlog
-        from mission.run_plot import plot_run
-        from mission.world import World
+        from mission.analysis.metrics import read_tlog
+        from mission.analysis.run_plot import plot_run
+        from mission.world.model import World
 
         trace = read_tlog(tlog, scenario)
         for path in plot_run(trace, World(scenario), tlog.parent / "g", tlog.parent / "plots"):
@@ -343,7 +343,7 @@ def _analyze(args) -> int:
 
 
 def _bench(args) -> int:
-    from mission.bench import format_table, run_benchmarks
+    from mission.runs.bench import format_table, run_benchmarks
 
     results = run_benchmarks(args.only)
     if args.json:

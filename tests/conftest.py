@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from mission.scenario import load_scenario
-from mission.settings import Scenario
-from mission.world import World
+from mission.config.scenario import load_scenario
+from mission.config.settings import Scenario
+from mission.world.model import World
 
 
 @pytest.fixture(scope="session")

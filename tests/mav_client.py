@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.frames import GeodeticFrame, enu_to_ned
-from mission.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.link.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.world.frames import GeodeticFrame, enu_to_ned
 
 GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190

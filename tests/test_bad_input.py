@@ -10,8 +10,8 @@ import pytest
 import ground_station.cli as gcs_cli
 import mission.cli as mission_cli
 import vehicle_sim.cli as vehicle_cli
-from mission.scenario import load_scenario
-from mission.waypoints import HEADER
+from mission.config.scenario import load_scenario
+from mission.link.waypoints import HEADER
 
 GOOD_ROW = "0\t1\t3\t16\t0\t0.1\t0\t0\t35.15\t136.96\t7.0\t1\n"
 

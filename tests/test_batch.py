@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from mission.batch import BatchOptions, Trial, finished_summary, run_batch
-from mission.batch_table import compare, method_stats, result_rows, table_rows
+from mission.runs.batch import BatchOptions, Trial, finished_summary, run_batch
+from mission.runs.batch_table import compare, method_stats, result_rows, table_rows
 from tests.processes import ROOT
 
 
@@ -105,7 +105,7 @@ def test_an_unfinished_or_foreign_run_directory_does_not_count(tmp_path):
 
 def test_rerunning_an_unfinished_run_starts_from_an_empty_directory(tmp_path):
     """What an interrupted run left (a partial tlog, no summary) is wiped before it reruns."""
-    from mission.batch import _start_run
+    from mission.runs.batch import _start_run
 
     run_dir = tmp_path / "runs" / "along-ac-0"
     run_dir.mkdir(parents=True)
@@ -193,7 +193,7 @@ def test_a_terminated_batch_leaves_no_process_behind(tmp_path):
 
 
 def test_a_batch_gives_runs_an_mpc_helper_only_where_each_has_a_core_for_it():
-    from mission.batch import helper_has_a_core
+    from mission.runs.batch import helper_has_a_core
 
     assert helper_has_a_core(1, 2) and helper_has_a_core(2, 4)
     assert not helper_has_a_core(2, 2) and not helper_has_a_core(1, 1)

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from mission import bench
+from mission.runs import bench
 
 
 @dataclass
@@ -27,7 +27,7 @@ def _run(solves: list[float], cycles: list[float]) -> SimpleNamespace:
 
 
 def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
-    import ground_station.detached
+    import mission.runs.detached
 
     repeats = iter(
         [  # solves (ms) and cycle times (ms) of three repeats of the same run
@@ -37,7 +37,7 @@ def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
         ]
     )
     monkeypatch.setattr(
-        ground_station.detached, "run_detached", lambda *args, **kwargs: next(repeats)
+        mission.runs.detached, "run_detached", lambda *args, **kwargs: next(repeats)
     )
     monkeypatch.setattr(bench, "_scipy_over_casadi", lambda *args: 12.0)
     rows = {r.name: r for r in bench.bench_ground_station(cycles=5, repeats=3)}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mission.camera import CameraModel, spherical, spherical_jacobian
+from mission.world.camera import CameraModel, spherical, spherical_jacobian
 
 
 def _to_cartesian(d: float, phi: float, theta: float) -> np.ndarray:

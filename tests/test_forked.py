@@ -1,4 +1,4 @@
-"""Forked children (mission.forked) against real forks: what they keep, what they report,
+"""Forked children (mission.procs.forked) against real forks: what they keep, what they report,
 how they end; and when forking is allowed."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from mission.forked import start_forked
+from mission.procs.forked import start_forked
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="POSIX fork only")
 
@@ -126,7 +126,7 @@ def _ignore_term_and_sleep(argv: list[str]) -> int:
 def test_a_process_with_a_second_thread_may_not_fork():
     script = (
         "import threading\n"
-        "from mission.forked import fork_is_safe\n"
+        "from mission.procs.forked import fork_is_safe\n"
         "print(fork_is_safe())\n"
         "stop = threading.Event()\n"
         "thread = threading.Thread(target=stop.wait)\n"

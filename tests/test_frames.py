@@ -6,8 +6,8 @@ import numpy as np
 import pymap3d
 import pytest
 
-from mission.frames import GeodeticFrame, ecef_to_geodetic, enu_to_ned, ned_to_enu
-from mission.settings import GeodeticAnchor
+from mission.config.settings import GeodeticAnchor
+from mission.world.frames import GeodeticFrame, ecef_to_geodetic, enu_to_ned, ned_to_enu
 
 
 @pytest.mark.parametrize(

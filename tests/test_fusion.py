@@ -17,7 +17,7 @@ from ground_station.fusion import (
     selective_fusion,
     support_feedback,
 )
-from mission.plan_files import read_plan
+from mission.link.plan_files import read_plan
 
 
 def _measure(world, truth_work, supports, rng, bias=None) -> list[SupportMeasurement]:

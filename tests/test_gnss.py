@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mission.scenario import load_scenario
-from mission.world import World
+from mission.config.scenario import load_scenario
+from mission.world.model import World
 
 OPEN_SKY_POINT = np.array([0.0, -15.0, 8.0])
 
@@ -165,7 +165,7 @@ def _points_around_the_bridge(n: int, seed: int = 3) -> np.ndarray:
 def test_fixes_are_the_same_with_remembered_geometry(along_world, monkeypatch):
     """Fix geometry remembered per visibility mask (and the memory emptied when full) gives
     the fixes that computing it afresh for every fix gives, bit for bit."""
-    from mission import gnss
+    from mission.world import gnss
 
     points = _points_around_the_bridge(300)
     fresh = World(along_world.scenario).gnss
@@ -194,7 +194,7 @@ def test_fixes_are_the_same_with_remembered_geometry(along_world, monkeypatch):
 
 def _every_row_computed(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(has_fix, cov_geom) with no memory and no grouping: the batched formula on every row."""
-    from mission import gnss
+    from mission.world import gnss
 
     visible = model.visibility(points)
     return gnss._covariance_from_visibility(
@@ -206,7 +206,7 @@ def test_a_few_points_geometry_equals_the_batched_computation(along_world, monke
     """Sigma_GNSS of a cycle's few fixes, looked up per mask, and of many points, grouped by
     mask, equal the batched computation on every row (a row does not depend on the rows
     beside it)."""
-    from mission import gnss
+    from mission.world import gnss
 
     points = _points_around_the_bridge(240, seed=4)
     model = World(along_world.scenario).gnss

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from pymavlink import mavutil
 
-from mission.plan_files import write_plan
-from mission.planner import plan_supports
-from mission.scenario import load_scenario
-from mission.world import World
+from mission.config.scenario import load_scenario
+from mission.link.plan_files import write_plan
+from mission.planning.planner import plan_supports
+from mission.world.model import World
 from tests.processes import ROOT, vehicle_process
 
 SHORT = """
@@ -179,9 +179,9 @@ def test_sim_state_never_reaches_the_estimator(along, tmp_path):
     from ground_station.cycle import control_cycle
     from ground_station.measurements import support_measurements
     from ground_station.station import GroundStation, StationConfig
-    from mission.frames import GeodeticFrame
-    from mission.mavlink_udp import MavlinkCodec
-    from mission.plan_files import read_plan
+    from mission.link.mavlink_udp import MavlinkCodec
+    from mission.link.plan_files import read_plan
+    from mission.world.frames import GeodeticFrame
     from vehicle_sim import telemetry
 
     world = World(along)
@@ -246,7 +246,7 @@ def test_a_vehicles_commands_and_tick_leave_in_one_datagram_and_are_resent_toget
     import socket
 
     from ground_station.station import GroundStation, StationConfig
-    from mission.mavlink_udp import MavlinkCodec
+    from mission.link.mavlink_udp import MavlinkCodec
 
     names = ("work", "support-1", "support-2", "support-3")
     sockets = {}

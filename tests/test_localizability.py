@@ -15,8 +15,8 @@ from ground_station.localizability import (
     hermite_zero_slope,
     inlined_hermite,
 )
-from mission.grid import VoxelGrid
-from mission.settings import Box
+from mission.config.settings import Box
+from mission.world.grid import VoxelGrid
 
 GRID = VoxelGrid(np.array([0.0, 0.0, 0.0]), 1.0, (5, 5, 5))
 

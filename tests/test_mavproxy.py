@@ -12,14 +12,14 @@ from pathlib import Path
 import numpy as np
 
 from ground_station.mission_client import MissionClient, MissionTransferError
-from mission.frames import GeodeticFrame
-from mission.waypoints import (
+from mission.link.waypoints import (
     WaypointRow,
     format_waypoints,
     read_waypoints,
     waypoint_rows_from_enu,
     write_waypoints,
 )
+from mission.world.frames import GeodeticFrame
 from tests.mav_client import MavClient
 from tests.processes import stop_process, vehicle_process
 

@@ -10,7 +10,7 @@ import pytest
 from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
 from ground_station.support_mpc import CONVERGED, SupportMpc
 from ground_station.work_mpc import predict_work
-from mission.plan_files import read_plan
+from mission.link.plan_files import read_plan
 
 
 def test_work_mpc_steps_greedily_and_advances_the_index():

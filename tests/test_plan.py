@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mission.errors import InputError
-from mission.plan_files import read_plan, vehicle_names
-from mission.planner import PlanningError, plan_supports
-from mission.scenario import load_scenario
-from mission.waypoints import read_waypoints
-from mission.world import World
-from mission.zone_placement import inside, path_samples
+from mission.config.errors import InputError
+from mission.config.scenario import load_scenario
+from mission.link.plan_files import read_plan, vehicle_names
+from mission.link.waypoints import read_waypoints
+from mission.planning.planner import PlanningError, plan_supports
+from mission.planning.zone_placement import inside, path_samples
+from mission.world.model import World
 
 ROUNDING_M = 0.12  # files hold 6 decimals of a degree (about 0.1 m)
 

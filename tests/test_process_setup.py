@@ -6,13 +6,13 @@ import os
 import subprocess
 import sys
 
-from mission.math_threads import THREAD_VARIABLES, use_one_math_thread
+from mission.procs.math_threads import THREAD_VARIABLES, use_one_math_thread
 
 
 def test_freezing_the_start_up_heap_exempts_what_was_loaded_from_collection():
     code = (
         "import gc, numpy, pymavlink.dialects.v20.ardupilotmega\n"
-        "from mission.cli_common import freeze_startup_heap\n"
+        "from mission.procs.cli_common import freeze_startup_heap\n"
         "before = gc.get_freeze_count()\n"
         "freeze_startup_heap()\n"
         "print(before, gc.get_freeze_count())\n"

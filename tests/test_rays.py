@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mission.rays import EmbreeRays, TrimeshRays, rtcore_scene
+from mission.world.rays import EmbreeRays, TrimeshRays, rtcore_scene
 
 
 @pytest.mark.skipif(rtcore_scene is None, reason="embreex has no wheel for this machine")
@@ -29,7 +29,7 @@ def test_embree_and_trimesh_agree_on_rays_and_segments(along_world):
 
 def test_the_fallback_engine_gives_the_same_gnss_visibility(along_world):
     """With trimesh's tracer the GNSS visibility is the same as with the default engine."""
-    from mission.structure import Structure
+    from mission.world.structure import Structure
 
     structure = along_world.structure
     fallback = Structure(structure.vertices, structure.faces, structure.boxes)
@@ -47,8 +47,8 @@ def test_box_triangles_match_trimesh_boxes():
     """Our triangulated box equals trimesh's: same corners, closed, outward, same volume."""
     import trimesh
 
-    from mission.settings import BoxPrimitive
-    from mission.structure import _box_triangles
+    from mission.config.settings import BoxPrimitive
+    from mission.world.structure import _box_triangles
 
     box = BoxPrimitive(name="b", min_m=(-1.0, 2.0, 0.5), max_m=(3.0, 2.5, 4.0))
     vertices, faces = _box_triangles(box)
@@ -67,7 +67,7 @@ def test_a_world_of_boxes_loads_without_trimesh():
     import sys
 
     code = (
-        "import sys; from mission.world import World; w = World.load('along'); "
+        "import sys; from mission.world.model import World; w = World.load('along'); "
         "w.sigma0_map(); print('trimesh' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

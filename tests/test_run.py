@@ -148,8 +148,8 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert dump.stdout.count("SET_POSITION_TARGET_LOCAL_NED") == 4 * summary["control_cycles"]
 
     # The fast tlog reader (skips undecoded kinds) equals pymavlink's, plain and signed.
-    from mission.analysis import read_tlog, read_tlog_with_mavutil
-    from mission.scenario import load_scenario
+    from mission.analysis.metrics import read_tlog, read_tlog_with_mavutil
+    from mission.config.scenario import load_scenario
 
     loaded = load_scenario(str(scenario))
     for run in ("a", "b"):

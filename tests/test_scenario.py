@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from mission.errors import ScenarioError
-from mission.scenario import embedded_scenario_names, load_scenario, read_yaml_mapping
-from mission.world import World
+from mission.config.errors import ScenarioError
+from mission.config.scenario import embedded_scenario_names, load_scenario, read_yaml_mapping
+from mission.world.model import World
 
 
 def test_both_embedded_scenarios_load():

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.errors import InputError
-from mission.frames import GeodeticFrame
-from mission.signing import read_signing_key
+from mission.config.errors import InputError
+from mission.link.signing import read_signing_key
+from mission.world.frames import GeodeticFrame
 from tests.mav_client import MavClient, last, truth_of
 from tests.processes import vehicle_process
 

@@ -14,7 +14,7 @@ import pytest
 from ground_station.support_mpc import CONVERGED, PlanRequest, SupportMpc, SupportPlan
 from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
 from ground_station.work_mpc import predict_work
-from mission.plan_files import read_plan
+from mission.link.plan_files import read_plan
 
 
 @pytest.fixture(scope="module")

@@ -12,8 +12,8 @@ import pytest
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.analysis import read_tlog, read_tlog_with_mavutil
-from mission.scenario import load_scenario
+from mission.analysis.metrics import read_tlog, read_tlog_with_mavutil
+from mission.config.scenario import load_scenario
 
 
 def _packet(system: int, message) -> bytes:

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.frames import GeodeticFrame, ned_to_enu
+from mission.world.frames import GeodeticFrame, ned_to_enu
 from tests.mav_client import MavClient, last, truth_of
 from tests.processes import vehicle_process
 

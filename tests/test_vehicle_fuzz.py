@@ -10,8 +10,8 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from ground_station.mission_client import MissionClient
-from mission.mavlink_udp import MavlinkCodec
-from mission.mission_items import MissionItem
+from mission.link.mavlink_udp import MavlinkCodec
+from mission.link.mission_items import MissionItem
 from tests.mav_client import MavClient
 from tests.processes import vehicle_process
 

@@ -7,15 +7,15 @@ import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from ground_station.mission_client import MissionClient
-from mission.frames import GeodeticFrame
-from mission.mission_items import MISSION, MissionItem
-from mission.waypoints import (
+from mission.link.mission_items import MISSION, MissionItem
+from mission.link.waypoints import (
     WaypointRow,
     format_waypoints,
     read_waypoints,
     waypoint_rows_from_enu,
     write_waypoints,
 )
+from mission.world.frames import GeodeticFrame
 from tests.mav_client import MavClient
 from tests.processes import vehicle_process
 

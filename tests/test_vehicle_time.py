@@ -96,7 +96,7 @@ def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout()
     which the camera sees the last known position (counted as a stale truth)."""
     import numpy as np
 
-    from mission.scenario import load_scenario
+    from mission.config.scenario import load_scenario
     from vehicle_sim.truth_link import TruthSender
 
     timeout = load_scenario("along").vehicle.truth_timeout_wall_s
@@ -130,7 +130,7 @@ def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has():
     waiting for it would only stall the support for the timeout at every such step."""
     import numpy as np
 
-    from mission.scenario import load_scenario
+    from mission.config.scenario import load_scenario
     from vehicle_sim.truth_link import TruthSender
 
     timeout = load_scenario("along").vehicle.truth_timeout_wall_s

@@ -1,1 +1,1 @@
-"""One simulated UAV: a MAVLink 2 endpoint over UDP with the paper's sensor models."""
+"""One simulated vehicle process. Imports: config, world, link, procs."""

@@ -2,7 +2,7 @@
 
 import sys
 
-from mission.math_threads import use_one_math_thread
+from mission.procs.math_threads import use_one_math_thread
 
 use_one_math_thread()
 

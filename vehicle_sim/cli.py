@@ -9,7 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from mission.cli_common import (
+from mission.config.errors import InputError
+from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
+from mission.link.plan_files import read_vehicle_waypoints
+from mission.link.signing import read_signing_key
+from mission.link.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
+from mission.procs.cli_common import (
     OneLineArgumentParser,
     add_link_arguments,
     freeze_startup_heap,
@@ -18,12 +23,7 @@ from mission.cli_common import (
     parse_point,
     run_guarded,
 )
-from mission.errors import InputError
-from mission.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
-from mission.plan_files import read_vehicle_waypoints
-from mission.signing import read_signing_key
-from mission.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
-from mission.world import World
+from mission.world.model import World
 from vehicle_sim.server import ClockSettings, VehicleServer, install_signal_handlers
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle

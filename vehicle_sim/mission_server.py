@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.mission_items import MISSION, MissionItem, check_item
+from mission.link.mission_items import MISSION, MissionItem, check_item
 
 
 @dataclass

@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from mission.mavlink_udp import Address, UdpEndpoint
+from mission.link.mavlink_udp import Address, UdpEndpoint
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 
@@ -321,6 +321,6 @@ def install_signal_handlers(stop: Callable[..., None], die_with_parent: bool) ->
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGINT, stop)
     if die_with_parent:
-        from mission.cli_common import die_with_parent as arrange
+        from mission.procs.cli_common import die_with_parent as arrange
 
         arrange()

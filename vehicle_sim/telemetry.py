@@ -7,9 +7,9 @@ import math
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.camera import Observation
-from mission.frames import GeodeticFrame, enu_to_ned
-from mission.gnss import GnssFix
+from mission.world.camera import Observation
+from mission.world.frames import GeodeticFrame, enu_to_ned
+from mission.world.gnss import GnssFix
 
 UINT16_UNKNOWN = 65535
 SOFTWARE_VERSION = (0 << 24) | (1 << 16) | (0 << 8) | 255  # 0.1.0, FIRMWARE_VERSION_TYPE_OFFICIAL

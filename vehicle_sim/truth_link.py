@@ -13,8 +13,8 @@ from collections import OrderedDict
 
 import numpy as np
 
-from mission.frames import ned_to_enu
-from mission.mavlink_udp import Address, MavlinkCodec, UdpEndpoint
+from mission.link.mavlink_udp import Address, MavlinkCodec, UdpEndpoint
+from mission.world.frames import ned_to_enu
 from vehicle_sim import telemetry
 
 KEEP_SAMPLES = 64

@@ -14,12 +14,12 @@ from typing import Any, ClassVar
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.frames import GeodeticFrame, ned_to_enu
-from mission.mavlink_udp import LinkCounters
-from mission.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
-from mission.settings import Scenario
-from mission.vehicle_identity import VehicleIdentity
-from mission.world import World
+from mission.config.settings import Scenario
+from mission.link.mavlink_udp import LinkCounters
+from mission.link.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
+from mission.link.vehicle_identity import VehicleIdentity
+from mission.world.frames import GeodeticFrame, ned_to_enu
+from mission.world.model import World
 from vehicle_sim import modes, telemetry
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
@@ -198,7 +198,7 @@ class Vehicle:
 
     def observe(self, work_truth: np.ndarray | None):
         """The camera's observation of the work UAV (not valid without its truth)."""
-        from mission.camera import Observation
+        from mission.world.camera import Observation
 
         if work_truth is None or self.identity.is_work:
             return Observation(False, None, math.nan)

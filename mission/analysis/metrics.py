@@ -1,0 +1,219 @@
+"""Metrics of a run from its tlog alone (plus the scenario's zones), as the paper's Table 3 counts.
+
+- truth: SIM_STATE of each vehicle, grouped by the simulated time the ground station logged;
+- the work UAV's estimate: the VISION_POSITION_ESTIMATE the ground station sent it (each one is
+  followed by the SET_POSITION_TARGET_LOCAL_NED for the same vehicle, which names it);
+- control cycles: the ground station's SYSTEM_TIME clock ticks to the work UAV;
+- completion: the ground station's "Mission complete" STATUSTEXT.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections import defaultdict
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+os.environ.setdefault("MAVLINK20", "1")
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from mission.config.settings import Scenario
+from mission.world.frames import GeodeticFrame, ned_to_enu
+from mission.world.model import World
+
+GCS_SYSTEM_ID = 255
+_LINK_EVENT = re.compile(r"^support-\d+ (lost|back)")
+_WANTED_IDS = frozenset(
+    {
+        mavlink2.MAVLINK_MSG_ID_SIM_STATE,
+        mavlink2.MAVLINK_MSG_ID_VISION_POSITION_ESTIMATE,
+        mavlink2.MAVLINK_MSG_ID_SET_POSITION_TARGET_LOCAL_NED,
+        mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME,
+        mavlink2.MAVLINK_MSG_ID_STATUSTEXT,
+    }
+)
+
+
+@dataclass
+class RunTrace:
+    """What a ground station's tlog says about a run, in simulated seconds."""
+
+    truth: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    estimates: dict[float, np.ndarray] = field(default_factory=dict)
+    ticks: set[float] = field(default_factory=set)
+    completion: float | None = None
+    link_events: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def supports(self) -> list[int]:
+        """System ids of the support vehicles (the work UAV is system 1)."""
+        return sorted({s for s, _ in self.truth if s != 1})
+
+    def track(self, system: int) -> tuple[np.ndarray, np.ndarray]:
+        """(times, positions) of one vehicle's truth."""
+        times = sorted(t for s, t in self.truth if s == system)
+        points = [self.truth[(system, t)] for t in times]
+        return np.array(times), np.array(points).reshape(-1, 3)
+
+
+def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
+    """Truth (SIM_STATE), the work UAV's estimates, clock ticks and completion from a tlog."""
+    return _trace_of(_tlog_messages(tlog), scenario)
+
+
+def read_tlog_with_mavutil(tlog: Path, scenario: Scenario) -> RunTrace:
+    """The same as :func:`read_tlog` through pymavlink's own tlog reader (every message
+    decoded; slower): the reference the fast reader is tested against."""
+    return _trace_of(_mavutil_messages(tlog), scenario)
+
+
+def _mavutil_messages(tlog: Path) -> Iterator[Any]:
+    """Every message of a tlog through pymavlink's tolerant reader."""
+    from pymavlink import mavutil  # 0.1 s to import (every dialect); the fast path needs none
+
+    log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega", robust_parsing=True)
+    return iter(log.recv_match, None)
+
+
+def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
+    frame = GeodeticFrame(scenario.world.anchor)
+    epoch = scenario.run.epoch_unix_s
+    trace = RunTrace()
+    pending_estimate: tuple[float, np.ndarray] | None = None
+    for message in messages:
+        kind = message.get_type()
+        t = round(message._timestamp - epoch, 3)
+        source = message.get_srcSystem()
+        if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
+            trace.truth[(source, t)] = frame.from_degE7(
+                message.lat_int, message.lon_int, message.alt
+            )
+        elif source != GCS_SYSTEM_ID:
+            continue
+        elif kind == "VISION_POSITION_ESTIMATE":
+            pending_estimate = (t, ned_to_enu(np.array([message.x, message.y, message.z])))
+        elif kind == "SET_POSITION_TARGET_LOCAL_NED":
+            if pending_estimate is not None and message.target_system == 1:
+                trace.estimates[pending_estimate[0]] = pending_estimate[1]
+            pending_estimate = None
+        elif kind == "SYSTEM_TIME" and message.time_boot_ms > 0:
+            trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
+        elif kind == "STATUSTEXT" and "Mission complete" in message.text:
+            trace.completion = t if trace.completion is None else trace.completion
+        elif kind == "STATUSTEXT" and _LINK_EVENT.match(message.text):
+            trace.link_events.append({"t": t, "event": message.text})
+    return trace
+
+
+def _tlog_messages(tlog: Path) -> Iterator[Any]:
+    """The messages of the kinds the metrics read, each with its ``_timestamp``.
+
+    A tlog is (8-byte big-endian microseconds, MAVLink packet) records. The packet headers
+    say each message's id and length, so the ~80 % of packets the metrics never read (GPS,
+    camera, attitude, heartbeats, ...) are skipped without decoding. Anything that is not a
+    well-formed MAVLink 2 record sends the whole file through pymavlink's tolerant reader.
+    """
+    data = tlog.read_bytes()
+    records = _wanted_records(data)
+    if records is None:
+        yield from _mavutil_messages(tlog)
+        return
+    parser = mavlink2.MAVLink(None)
+    for usec, packet in records:
+        try:
+            message = parser.decode(bytearray(packet))
+        except mavlink2.MAVError:
+            continue  # a corrupt packet: the reference reader drops it too
+        message._timestamp = usec * 1.0e-6
+        yield message
+
+
+def _wanted_records(data: bytes) -> list[tuple[int, bytes]] | None:
+    """(microseconds, packet) of the wanted kinds, or None if ``data`` is not plain MAVLink 2."""
+    records, offset, end = [], 0, len(data)
+    while offset < end:
+        start = offset + 8
+        if start + 10 > end or data[start] != mavlink2.PROTOCOL_MARKER_V2:
+            return None
+        length = data[start + 1]
+        size = 10 + length + 2 + (13 if data[start + 2] & mavlink2.MAVLINK_IFLAG_SIGNED else 0)
+        if start + size > end:
+            return None
+        msgid = int.from_bytes(data[start + 7 : start + 10], "little")
+        if msgid in _WANTED_IDS:
+            usec = int.from_bytes(data[offset:start], "big")
+            records.append((usec, data[start : start + size]))
+        offset = start + size
+    return records
+
+
+def zone_steps(trace: RunTrace, world: World) -> dict[int, list[float]]:
+    """Per support system id, the clock ticks at which its truth was inside a zone."""
+    steps: dict[int, list[float]] = defaultdict(list)
+    ticks = sorted(trace.ticks)
+    for system in trace.supports:
+        times = [t for t in ticks if (system, t) in trace.truth]
+        if not times:
+            continue
+        inside = world.in_zone(np.array([trace.truth[(system, t)] for t in times]))
+        steps[system] = [t for t, hit in zip(times, inside) if hit]
+    return steps
+
+
+def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
+    """(times, |xhat - x|) of the work UAV at every cycle with both."""
+    pairs = [
+        (t, float(np.linalg.norm(x - trace.truth[(1, t)])))
+        for t, x in sorted(trace.estimates.items())
+        if (1, t) in trace.truth
+    ]
+    return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+
+
+def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
+    """The tlog-determined metrics of summary.json."""
+    trace = read_tlog(tlog, scenario)
+    steps = zone_steps(trace, World(scenario))
+    _, errors = work_errors(trace)
+    counts = {f"support-{s - 1}": len(steps.get(s, [])) for s in trace.supports}
+    return {
+        "completed": trace.completion is not None,
+        "completion_time_s": trace.completion,
+        "control_cycles": len(trace.estimates),
+        "multipath_steps": counts,
+        "multipath_steps_total": int(sum(counts.values())),
+        "work_error_m": _stats([float(e) for e in errors]),
+        "link_events": trace.link_events,
+    }
+
+
+def _stats(values: list[float]) -> dict[str, float | None]:
+    if not values:
+        return {"mean": None, "p95": None, "max": None}
+    return {
+        "mean": round(float(np.mean(values)), 4),
+        "p95": round(float(np.percentile(values, 95)), 4),
+        "max": round(float(np.max(values)), 4),
+    }
+
+
+def mpc_stats(records: Path) -> dict[str, float | None]:
+    """Median and p95 of the support-MPC solve times in records.jsonl."""
+    import json
+
+    times = [
+        m["ms"]
+        for line in records.read_text().splitlines()
+        for m in json.loads(line)["mpc"].values()
+    ]
+    if not times:
+        return {"median": None, "p95": None}
+    return {
+        "median": round(float(np.median(times)), 3),
+        "p95": round(float(np.percentile(times, 95)), 3),
+    }

@@ -1,0 +1,203 @@
+"""The paper's figures for one run, from its tlog and G snapshots (``mission analyze --plots``).
+
+- ``trajectories.png`` (Figs. 6-9): 3-D, top and side views of every UAV's true path with the
+  bridge, the zones and the final G as background;
+- ``error.png``: the work UAV's localization error per control cycle, the cycles support 1 spent
+  in a zone shaded red;
+- ``g_update.png`` (Fig. 10): G before and after the run through the most-changed voxel, and the
+  voxels the updates touched.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+from mission.analysis.metrics import RunTrace, work_errors, zone_steps
+from mission.analysis.world_plot import draw_background
+from mission.procs.atomic import write_atomically
+from mission.world.model import Sigma0Map, World
+
+COLORS = {1: "tab:red", 2: "tab:blue", 3: "tab:green", 4: "tab:purple", 5: "tab:olive"}
+AXES = "xyz"
+
+
+def plot_run(trace: RunTrace, world: World, g_dir: Path, out_dir: Path) -> list[Path]:
+    """Write the three figures into ``out_dir``; return their paths."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    sigma0 = world.sigma0_map()
+    initial, final = _snapshots(g_dir, sigma0)
+    paths = [out_dir / "trajectories.png", out_dir / "error.png", out_dir / "g_update.png"]
+    _trajectories(trace, world, dataclasses.replace(sigma0, sigma_m=final), paths[0])
+    _error(trace, world, paths[1])
+    _g_update(world, sigma0, initial, final, paths[2])
+    return paths
+
+
+def _snapshots(g_dir: Path, sigma0: Sigma0Map) -> tuple[np.ndarray, np.ndarray]:
+    """G at the start and the end (sigma_0 for both when the run kept no snapshots)."""
+    shape = sigma0.grid.shape
+    initial = _load(g_dir / "G_initial.npy", shape)
+    final = _load(g_dir / "G_final.npy", shape)
+    if final is None:
+        numbered = sorted(g_dir.glob("G_[0-9]*.npy"))
+        final = _load(numbered[-1], shape) if numbered else None
+    base = sigma0.sigma_m.reshape(shape)
+    initial = base if initial is None else initial
+    return initial, initial if final is None else final
+
+
+def _load(path: Path, shape: tuple[int, ...]) -> np.ndarray | None:
+    try:
+        values = np.load(path)
+    except (OSError, ValueError):
+        return None
+    return values.reshape(shape) if values.size == np.prod(shape) else None
+
+
+def _label(system: int) -> str:
+    return "work UAV" if system == 1 else f"support {system - 1}"
+
+
+def _trajectories(trace: RunTrace, world: World, g_map: Sigma0Map, path: Path) -> None:
+    fig = plt.figure(figsize=(15, 11))
+    ax3d = fig.add_subplot(2, 2, 1, projection="3d")
+    ax3d.add_collection3d(
+        Poly3DCollection(world.structure.mesh.triangles, facecolor="0.6", alpha=0.15)
+    )
+    systems = [1, *trace.supports]
+    for system in systems:
+        _, points = trace.track(system)
+        if len(points):
+            ax3d.plot(*points.T, color=COLORS.get(system, "k"), label=_label(system))
+    for zone in world.scenario.world.zones:
+        _box3d(ax3d, np.array(zone.min_m), np.array(zone.max_m))
+    ax3d.set_xlabel("x [m]")
+    ax3d.set_ylabel("y [m]")
+    ax3d.set_zlabel("z [m]")
+    ax3d.set_title("3-D view (true positions)")
+    ax3d.legend(fontsize=7)
+    level = _support_level(trace)
+    views = [(0, 1, 2, "top view (x-y)", 2), (0, 2, 1, "side view (x-z)", 3)]
+    for a, b, normal, title, slot in views:
+        ax = fig.add_subplot(2, 2, slot)
+        point = np.full(3, level) if normal == 2 else _zone_centre(world, level)
+        k = draw_background(ax, world, g_map, point, a, b, normal, alpha=0.55, label="G [m]")
+        for system in systems:
+            _, points = trace.track(system)
+            if len(points):
+                ax.plot(points[:, a], points[:, b], color=COLORS.get(system, "k"), lw=1)
+        ax.set_xlabel(f"{AXES[a]} [m]")
+        ax.set_ylabel(f"{AXES[b]} [m]")
+        centre = g_map.grid.axis_centers(normal)[k]
+        ax.set_title(f"{title}; final G at {AXES[normal]} = {centre:g} m")
+        ax.set_aspect("equal")
+    ax = fig.add_subplot(2, 2, 4)
+    ax.axis("off")
+    ax.text(0, 0.5, _legend_text(trace), family="monospace", fontsize=10, va="center")
+    fig.suptitle(f"scenario '{world.scenario.name}': trajectories, zones and the final G")
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def _error(trace: RunTrace, world: World, path: Path) -> None:
+    times, errors = work_errors(trace)
+    in_zone = zone_steps(trace, world).get(2, [])
+    fig, ax = plt.subplots(figsize=(11, 4))
+    half = world.scenario.control.t_cont_s / 2
+    for t in in_zone:
+        ax.axvspan(t - half, t + half, color="red", alpha=0.25, lw=0)
+    ax.plot(times, errors, color="k", lw=0.8, label="|xhat - x|")
+    ax.axvspan(0, 0, color="red", alpha=0.25, label="support 1 in a zone")
+    ax.set_xlabel("simulated time [s]")
+    ax.set_ylabel("work UAV localization error [m]")
+    ax.set_title(f"scenario '{world.scenario.name}': {len(in_zone)} cycles of support 1 in a zone")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def _g_update(
+    world: World, sigma0: Sigma0Map, initial: np.ndarray, final: np.ndarray, path: Path
+) -> None:
+    change = final - initial
+    grid = sigma0.grid
+    index = np.unravel_index(int(np.argmax(np.abs(change))), change.shape)
+    point = grid.origin_m + grid.voxel_m * (np.array(index) + 0.5)
+    fig, axes = plt.subplots(2, 3, figsize=(16, 9))
+    panels = [("before", initial), ("after", final)]
+    for row, (a, b, normal) in enumerate(((0, 1, 2), (0, 2, 1))):
+        for col, (name, values) in enumerate(panels):
+            ax = axes[row, col]
+            g_map = dataclasses.replace(sigma0, sigma_m=values)
+            draw_background(ax, world, g_map, point, a, b, normal, label="G [m]")
+            ax.set_title(f"G {name}, {AXES[normal]} = {point[normal]:g} m")
+            ax.set_aspect("equal")
+        ax = axes[row, 2]
+        k = int(index[normal])
+        delta = np.take(change, k, axis=normal)
+        lo, hi = grid.origin_m, grid.origin_m + grid.voxel_m * np.array(grid.shape)
+        limit = max(float(np.max(np.abs(delta))), 1e-6)
+        image = ax.imshow(
+            delta.T,
+            origin="lower",
+            extent=(lo[a], hi[a], lo[b], hi[b]),
+            cmap="coolwarm",
+            vmin=-limit,
+            vmax=limit,
+            interpolation="nearest",
+        )
+        plt.colorbar(image, ax=ax, label="G after - before [m]", shrink=0.8)
+        ax.set_title(f"updated voxels ({int(np.count_nonzero(change))} in the whole map)")
+        ax.set_aspect("equal")
+        for ax in axes[row]:
+            ax.set_xlabel(f"{AXES[a]} [m]")
+            ax.set_ylabel(f"{AXES[b]} [m]")
+    fig.suptitle(f"scenario '{world.scenario.name}': the GNSS-localizability map G")
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def _support_level(trace: RunTrace) -> float:
+    heights = [trace.track(s)[1][:, 2] for s in trace.supports]
+    heights = [h for h in heights if len(h)]
+    return float(np.median(np.concatenate(heights))) if heights else 7.5
+
+
+def _zone_centre(world: World, level: float) -> np.ndarray:
+    zones = world.scenario.world.zones
+    if not zones:
+        return np.full(3, level)
+    return (np.array(zones[0].min_m) + np.array(zones[0].max_m)) / 2
+
+
+def _legend_text(trace: RunTrace) -> str:
+    lines = ["colours:"]
+    lines += [f"  {COLORS.get(s, 'k'):<12} {_label(s)}" for s in [1, *trace.supports]]
+    lines += ["  magenta box  multipath zone", "  grey         structure"]
+    done = "not completed" if trace.completion is None else f"completed at {trace.completion} s"
+    return "\n".join([*lines, "", done])
+
+
+def _box3d(ax, lo: np.ndarray, hi: np.ndarray) -> None:
+    corners = np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
+    for i in range(8):
+        for j in range(i + 1, 8):
+            if np.count_nonzero(corners[i] != corners[j]) == 1:
+                ax.plot(*corners[[i, j]].T, color="magenta", lw=1.5)
+
+
+def _save(fig, path: Path) -> None:
+    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=100, format="png"))
+    plt.close(fig)

@@ -1,0 +1,1 @@
+"""Scenario settings: validated dataclasses, the YAML loader, input errors. Imports: nothing."""

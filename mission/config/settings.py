@@ -1,0 +1,389 @@
+"""Scenario settings: frozen dataclasses, one per concern, each validating itself.
+
+Every number has its default in ``mission/scenarios/defaults.yaml`` (the single source of
+defaults); field names carry their units (``_m``, ``_s``, ``_deg``, ``_hz``, ``_m_s``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from datetime import datetime
+from typing import Literal
+
+from mission.config.errors import FieldProblem
+
+Vec3 = tuple[float, float, float]
+
+
+def _require(condition: bool, field: str, problem: str) -> None:
+    if not condition:
+        raise FieldProblem(field, problem)
+
+
+def _positive(owner: object, *names: str) -> None:
+    for name in names:
+        _require(getattr(owner, name) > 0, name, f"must be positive, got {getattr(owner, name)}")
+
+
+def _non_negative(owner: object, *names: str) -> None:
+    for name in names:
+        value = getattr(owner, name)
+        _require(value >= 0, name, f"must not be negative, got {value}")
+
+
+@dataclass(frozen=True)
+class Box:
+    """Axis-aligned box in the world frame (ENU, metres)."""
+
+    min_m: Vec3
+    max_m: Vec3
+
+    def __post_init__(self) -> None:
+        for axis in range(3):
+            _require(
+                self.min_m[axis] < self.max_m[axis],
+                "max_m",
+                f"must exceed min_m on every axis (axis {'xyz'[axis]}: "
+                f"{self.min_m[axis]} >= {self.max_m[axis]})",
+            )
+
+    def contains_box(self, other: Box) -> bool:
+        """True when ``other`` lies inside this box (faces may touch)."""
+        return all(
+            self.min_m[a] <= other.min_m[a] and other.max_m[a] <= self.max_m[a] for a in range(3)
+        )
+
+    @property
+    def size_m(self) -> Vec3:
+        """Edge lengths along x, y, z."""
+        return tuple(hi - lo for lo, hi in zip(self.min_m, self.max_m))  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class GeodeticAnchor:
+    """Geodetic origin of the local ENU world frame (WGS-84)."""
+
+    lat_deg: float
+    lon_deg: float
+    alt_m: float
+
+    def __post_init__(self) -> None:
+        _require(-90 <= self.lat_deg <= 90, "lat_deg", f"must be in [-90, 90], got {self.lat_deg}")
+        _require(
+            -180 <= self.lon_deg <= 180, "lon_deg", f"must be in [-180, 180], got {self.lon_deg}"
+        )
+
+
+@dataclass(frozen=True)
+class BoxPrimitive:
+    """A solid box of the structure (deck, pier, ...)."""
+
+    name: str
+    min_m: Vec3
+    max_m: Vec3
+
+    def __post_init__(self) -> None:
+        Box(self.min_m, self.max_m)
+
+
+@dataclass(frozen=True)
+class StructureSettings:
+    """The structure: primitives and/or a mesh file (STL/OBJ/PLY, metres, world frame).
+
+    Both are used when both are given; set ``primitives: []`` to use the mesh file alone.
+    """
+
+    mesh_file: str | None
+    primitives: list[BoxPrimitive]
+
+    def __post_init__(self) -> None:
+        _require(
+            bool(self.primitives) or self.mesh_file is not None,
+            "primitives",
+            "the structure needs at least one primitive or a mesh_file",
+        )
+
+
+@dataclass(frozen=True)
+class Zone:
+    """A multipath-affected space: GNSS fixes inside it are offset by ``offset_m``."""
+
+    name: str
+    min_m: Vec3
+    max_m: Vec3
+    offset_m: Vec3
+
+    def __post_init__(self) -> None:
+        Box(self.min_m, self.max_m)
+
+    @property
+    def box(self) -> Box:
+        """The zone's extent as a box."""
+        return Box(self.min_m, self.max_m)
+
+
+@dataclass(frozen=True)
+class WorldSettings:
+    """Structure, workspace and multipath zones (zones are known to the vehicles only)."""
+
+    anchor: GeodeticAnchor
+    workspace: Box
+    structure: StructureSettings
+    zones: list[Zone]
+
+    def __post_init__(self) -> None:
+        for i, zone in enumerate(self.zones):
+            _require(
+                self.workspace.contains_box(zone.box),
+                f"zones[{i}]",
+                f"zone '{zone.name}' {zone.min_m}..{zone.max_m} lies outside the workspace "
+                f"{self.workspace.min_m}..{self.workspace.max_m}",
+            )
+        names = [z.name for z in self.zones]
+        for i, name in enumerate(names):
+            _require(names.index(name) == i, f"zones[{i}].name", f"duplicate zone name '{name}'")
+
+
+@dataclass(frozen=True)
+class SkySettings:
+    """Satellite sky: a table of azimuth/elevation rows and the epoch to use."""
+
+    table: str
+    epoch_utc: str
+    elevation_mask_deg: float
+    constellations: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        try:
+            datetime.fromisoformat(self.epoch_utc.replace("Z", "+00:00"))
+        except ValueError:
+            raise FieldProblem(
+                "epoch_utc", f"not an ISO-8601 time like 2021-10-01T03:00:00Z: {self.epoch_utc!r}"
+            ) from None
+        _require(
+            0 <= self.elevation_mask_deg < 90,
+            "elevation_mask_deg",
+            f"must be in [0, 90), got {self.elevation_mask_deg}",
+        )
+        _require(bool(self.constellations), "constellations", "must name at least one")
+        for i, code in enumerate(self.constellations):
+            _require(
+                len(code) == 1 and code.isalpha() and code.isupper(),
+                f"constellations[{i}]",
+                f"must be a one-letter system code such as G or R, got {code!r}",
+            )
+
+
+@dataclass(frozen=True)
+class GnssSettings:
+    """GNSS of a support UAV (paper 3.1.1)."""
+
+    sigma_uere_m: float
+
+    def __post_init__(self) -> None:
+        _positive(self, "sigma_uere_m")
+
+
+@dataclass(frozen=True)
+class CameraSettings:
+    """Relative observation by a support UAV's camera (paper 3.1.2).
+
+    sigma_d(d) = sigma_d_a2_per_m d^2 + sigma_d_a1 d + sigma_d_a0_m.
+    """
+
+    sigma_d_a2_per_m: float
+    sigma_d_a1: float
+    sigma_d_a0_m: float
+    sigma_elevation_deg: float
+    sigma_azimuth_deg: float
+    range_m: float
+
+    def __post_init__(self) -> None:
+        _non_negative(self, "sigma_d_a2_per_m", "sigma_d_a1")
+        _positive(self, "sigma_d_a0_m", "sigma_elevation_deg", "sigma_azimuth_deg", "range_m")
+
+
+@dataclass(frozen=True)
+class FusionSettings:
+    """Selective fusion (paper 3.2.1) with the candidate-particle sets of MODEL.md."""
+
+    broad_particles: int
+    local_particles: int
+    broad_sigma_m: float
+    rho_threshold: float
+
+    def __post_init__(self) -> None:
+        _require(self.broad_particles >= 2, "broad_particles", "must be at least 2")
+        _non_negative(self, "local_particles")
+        _positive(self, "broad_sigma_m")
+        _require(
+            -1 <= self.rho_threshold <= 1,
+            "rho_threshold",
+            f"must be in [-1, 1], got {self.rho_threshold}",
+        )
+
+
+@dataclass(frozen=True)
+class MapSettings:
+    """GNSS-localizability map G (paper 4.1)."""
+
+    voxel_size_m: float
+    eta: float
+    neighborhood: float
+    no_fix_sigma_m: float
+
+    def __post_init__(self) -> None:
+        _positive(self, "voxel_size_m", "no_fix_sigma_m")
+        _require(0 <= self.eta <= 1, "eta", f"must be in [0, 1], got {self.eta}")
+        _non_negative(self, "neighborhood")
+
+
+@dataclass(frozen=True)
+class ControlSettings:
+    """MPC and control-cycle parameters (paper 4.2, Table 2 as MODEL.md fills it)."""
+
+    horizon_steps: int
+    t_pred_s: float
+    t_cont_s: float
+    s_max_work_m_s: float
+    s_max_support_m_s: float
+    w_gnss: float
+    w_interval: float
+    w_waypoint: float
+    w_relative: float
+    w_penalty: float
+    arrival_tol_m: float
+    support_max_sigma0_m: float
+    los_penalty: Literal["visible-point", "paper"]
+    mpc_solver: Literal["fatrop", "ipopt"]
+
+    def __post_init__(self) -> None:
+        _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
+        _positive(self, "t_pred_s", "t_cont_s", "s_max_work_m_s", "s_max_support_m_s")
+        _positive(self, "arrival_tol_m", "support_max_sigma0_m")
+        _non_negative(self, "w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")
+
+    @property
+    def d_max_work_m(self) -> float:
+        """Largest work-UAV step per prediction step."""
+        return self.s_max_work_m_s * self.t_pred_s
+
+    @property
+    def d_max_support_m(self) -> float:
+        """Largest support-UAV step per prediction step."""
+        return self.s_max_support_m_s * self.t_pred_s
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """How a run goes: its time limit and the simulated epoch of t = 0."""
+
+    timeout_s: float
+    epoch_utc: str
+
+    def __post_init__(self) -> None:
+        _positive(self, "timeout_s")
+        _require(math.isfinite(self.timeout_s), "timeout_s", "must be finite")
+        try:
+            datetime.fromisoformat(self.epoch_utc.replace("Z", "+00:00"))
+        except ValueError:
+            raise FieldProblem("epoch_utc", f"not an ISO-8601 time: {self.epoch_utc!r}") from None
+
+    @property
+    def epoch_unix_s(self) -> float:
+        """The epoch as seconds since 1970 (UTC)."""
+        return datetime.fromisoformat(self.epoch_utc.replace("Z", "+00:00")).timestamp()
+
+
+@dataclass(frozen=True)
+class TaskSettings:
+    """The task: the work UAV's inspection waypoints and the support UAVs accompanying it.
+
+    ``waypoints_dir`` holds the planned QGC WPL 110 files (``work.waypoints``,
+    ``support-N.waypoints``), relative to the scenario file that names it.
+    """
+
+    supports: int
+    work_waypoints_m: list[Vec3]
+    waypoints_dir: str
+
+    def __post_init__(self) -> None:
+        _require(1 <= self.supports <= 50, "supports", f"must be in 1..50, got {self.supports}")
+        _require(len(self.work_waypoints_m) >= 2, "work_waypoints_m", "needs at least 2 points")
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """The offline planner of the support UAVs' paths (MODEL.md 3.3; the paper's ref. [18])."""
+
+    lattice_m: float
+    w_gnss_per_m2: float
+    w_relative_per_m2: float
+    w_move_per_m: float
+    w_spread: float
+    min_separation_m: float
+    clearance_m: float
+    min_altitude_m: float
+    max_range_fraction: float
+    rounds: int
+
+    def __post_init__(self) -> None:
+        _positive(self, "lattice_m", "max_range_fraction")
+        _non_negative(self, "w_gnss_per_m2", "w_relative_per_m2", "w_move_per_m", "w_spread")
+        _non_negative(self, "min_separation_m", "clearance_m", "min_altitude_m")
+        _require(self.max_range_fraction <= 1, "max_range_fraction", "must be at most 1")
+        _require(self.rounds >= 1, "rounds", "must be at least 1")
+
+
+@dataclass(frozen=True)
+class VehicleSettings:
+    """A simulated vehicle: realism, failsafe, telemetry rates and protocol timing.
+
+    Rates are in simulated time; the ``*_wall_s`` timeouts are wall-clock seconds, divided by
+    the speed-up in real-time mode.
+    """
+
+    tracking_noise_m: float
+    failsafe_s: float
+    heartbeat_hz: float
+    status_hz: float
+    sensor_hz: float
+    lockstep_timeout_wall_s: float
+    truth_timeout_wall_s: float
+    mission_timeout_wall_s: float
+    mission_retries: int
+    mission_capacity: int
+
+    def __post_init__(self) -> None:
+        _non_negative(self, "tracking_noise_m")
+        _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
+        _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
+        _require(self.mission_retries >= 0, "mission_retries", "must not be negative")
+        _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A complete scenario: everything a run needs to know, validated."""
+
+    name: str
+    description: str
+    source: str
+    world: WorldSettings
+    sky: SkySettings
+    gnss: GnssSettings
+    camera: CameraSettings
+    fusion: FusionSettings
+    map: MapSettings
+    control: ControlSettings
+    run: RunSettings
+    task: TaskSettings
+    planner: PlannerSettings
+    vehicle: VehicleSettings
+
+    def __post_init__(self) -> None:
+        for i, point in enumerate(self.task.work_waypoints_m):
+            box = self.world.workspace
+            inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))
+            _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")

@@ -1,0 +1,1 @@
+"""Support-path planner and zone placement. Imports: config, world, link, procs, analysis."""

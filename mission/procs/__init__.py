@@ -1,0 +1,1 @@
+"""Process helpers: forks, names, one-line CLI errors, atomic writes. Imports: config, link."""

@@ -1,0 +1,1 @@
+"""Whole runs: orchestrator, batches, benchmarks, detached run. Imports: all but mission.cli."""

@@ -1,0 +1,337 @@
+"""``python -m mission bench``: every benchmark of the project, as a table or one JSON object.
+
+Benchmarks measure medians over repeats on this machine; targets are the issues' figures.
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
+
+
+@dataclass(frozen=True)
+class BenchResult:
+    """One measured figure and its target."""
+
+    name: str
+    value: float
+    unit: str
+    target: str
+    ok: bool | None  # None: a reference figure with no target
+
+
+def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
+    """Time to build the sigma_0 map of the default workspace (40,000 voxels x 15 satellites)."""
+    from mission.world.model import World
+
+    world = World.load("along")
+    times = [world.sigma0_map().build_s for _ in range(repeats)]
+    median = statistics.median(times)
+    return [BenchResult("sigma0_map_build_s", median, "s", "<= 3", median <= 3.0)]
+
+
+def bench_vehicle(steps: int = 1000, repeats: int = 3, pings: int = 500) -> list[BenchResult]:
+    """Lockstep steps per second of one vehicle under a minimal driver; COMMAND_LONG round trip."""
+    process, address = _start_vehicle()
+    try:
+        endpoint = UdpEndpoint(MavlinkCodec(255, 190))
+        queue = MessageQueue(endpoint)
+        steps_per_s = statistics.median(
+            _drive_lockstep(endpoint, address, steps, first=1 + r * steps) for r in range(repeats)
+        )
+        rtts = []
+        command = mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL
+        for _ in range(pings):
+            sent = time.perf_counter()
+            endpoint.send(
+                mavlink2.MAVLink_command_long_message(
+                    2, 1, command, 0, mavlink2.MAVLINK_MSG_ID_HEARTBEAT, 0, 0, 0, 0, 0, 0
+                ),
+                [address],
+            )
+            _wait(queue, lambda m: m.get_type() == "COMMAND_ACK" and m.command == command)
+            rtts.append((time.perf_counter() - sent) * 1000)
+        endpoint.close()
+    finally:
+        process.terminate()
+        process.wait(timeout=10)
+    rtt = statistics.median(rtts)
+    return [
+        BenchResult("vehicle_steps_per_s", steps_per_s, "steps/s", ">= 2000", steps_per_s >= 2000),
+        BenchResult("mavlink_rtt_ms_median", rtt, "ms", "< 1", rtt < 1.0),
+    ]
+
+
+def _drive_lockstep(
+    endpoint: UdpEndpoint, address: tuple[str, int], steps: int, first: int = 1
+) -> float:
+    """Tick the vehicle ``steps`` times as a minimal driver would: raw datagrams, no decoding
+    except spotting the SYSTEM_TIME step marker by its message id in the packet headers."""
+    codec = endpoint.codec
+    ticks = [
+        codec.encode(mavlink2.MAVLink_system_time_message(0, 500 * k))
+        for k in range(first, first + steps)
+    ]
+    marker = mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME.to_bytes(3, "little")
+    sock = endpoint.sock
+    sock.setblocking(True)
+    sock.settimeout(5.0)
+    start = time.perf_counter()
+    deadline = start + 60.0
+    for tick in ticks:
+        sock.sendto(tick, address)
+        while True:
+            datagram = sock.recv(65535)
+            if _has_message(datagram, marker):
+                break
+            if time.perf_counter() > deadline:
+                raise RuntimeError("the vehicle stopped answering clock ticks")
+    elapsed = time.perf_counter() - start
+    sock.setblocking(False)
+    return steps / elapsed
+
+
+def _has_message(datagram: bytes, message_id: bytes) -> bool:
+    """Whether a datagram of MAVLink 2 packets holds one with this id (headers only)."""
+    offset = 0
+    while offset + 10 <= len(datagram) and datagram[offset] == 0xFD:
+        if datagram[offset + 7 : offset + 10] == message_id:
+            return True
+        signed = datagram[offset + 2] & 0x01
+        offset += 12 + datagram[offset + 1] + (13 if signed else 0)
+    return False
+
+
+def _start_vehicle() -> tuple[subprocess.Popen, tuple[str, int]]:
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "vehicle_sim",
+            "--vehicle",
+            "support-1",
+            "--port",
+            "0",
+            "--home",
+            "0",
+            "-10",
+            "7",
+            "--exit-with-parent",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert process.stderr is not None
+    line = process.stderr.readline()
+    if "listening on" not in line:
+        process.kill()
+        raise RuntimeError(f"vehicle did not start: {line.strip()}")
+    host_port = line.split("listening on ")[1].split(",")[0]
+    host, port = host_port.rsplit(":", 1)
+    return process, (host, int(port))
+
+
+def _wait(queue: MessageQueue, match: Callable, timeout_s: float = 5.0) -> None:
+    deadline = time.perf_counter() + timeout_s
+    while (got := queue.next(deadline - time.perf_counter())) is not None:
+        if match(got[0]):
+            return
+    raise RuntimeError("benchmark peer stopped answering")
+
+
+def bench_ground_station(
+    cycles: int = 160, scipy_problems: int = 5, repeats: int = 3
+) -> list[BenchResult]:
+    """MPC solve times and cycle time over a detached Along run (AC), each the median over
+    ``repeats`` runs; scipy vs casadi."""
+    import numpy as np
+
+    from mission.link.plan_files import read_plan
+    from mission.runs.detached import run_detached
+    from mission.world.model import World
+
+    world = World.load("along")
+    plan = read_plan(world.scenario)
+    waypoints = {
+        "work": plan.work,
+        **{f"support-{n + 1}": plan.supports[n] for n in range(len(plan.supports))},
+    }
+    medians, p95s, cycles_ms = [], [], []
+    for _ in range(repeats):  # the same run each time: only the timings differ
+        run = run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
+        solves = [p.solve_ms for o in run.outputs for p in o.support_plans.values()]
+        medians.append(statistics.median(solves))
+        p95s.append(float(np.percentile(solves, 95)))
+        cycles_ms.append(statistics.median(o.cycle_ms for o in run.outputs))
+    ratio = _scipy_over_casadi(world, plan, scipy_problems)
+    median, p95 = statistics.median(medians), statistics.median(p95s)
+    cycle = statistics.median(cycles_ms)
+    return [
+        BenchResult("support_mpc_solve_ms_median", median, "ms", "<= 5", median <= 5),
+        BenchResult("support_mpc_solve_ms_p95", p95, "ms", "<= 15", p95 <= 15),
+        BenchResult("gcs_cycle_ms_median", cycle, "ms", "<= 25", cycle <= 25),
+        BenchResult("scipy_over_casadi_ratio", ratio, "x", ">= 10", ratio >= 10),
+    ]
+
+
+def _scipy_over_casadi(world, plan, problems: int) -> float:
+    """Median time ratio SLSQP / our solver on the same support-MPC problems (optima within
+    1 cm)."""
+    import numpy as np
+    from scipy.optimize import minimize
+
+    from ground_station.support_mpc import SupportMpc, support_cost_numpy
+    from ground_station.work_mpc import predict_work
+
+    control = world.scenario.control
+    grid = world.map_grid()
+    g = world.sigma0_map().sigma_m
+    mpc = SupportMpc(control, grid, world.camera)
+    ratios = []
+    u = control.horizon_steps
+    for i in range(problems):
+        yhat = plan.supports[0][i] + np.array([0.3, -0.2, 0.1])
+        work = predict_work(
+            plan.work[i],
+            i + 1,
+            plan.work,
+            control.horizon_steps,
+            control.d_max_work_m,
+            control.arrival_tol_m,
+        )
+        start = time.perf_counter()
+        result = mpc.solve(
+            yhat, plan.supports[0], work.path, work.indices, g, world.camera.observable
+        )
+        casadi_s = time.perf_counter() - start
+        targets, terminal = plan.supports[0][work.indices[:u]], plan.supports[0][work.indices[u]]
+
+        def cost(x, targets=targets, terminal=terminal, work=work, result=result, yhat=yhat):
+            return support_cost_numpy(
+                x,
+                yhat,
+                targets,
+                terminal,
+                work.path[:u],
+                result.blocked,
+                g,
+                grid,
+                control,
+                result.anchors,
+            )
+
+        def steps_left(x, yhat=yhat):
+            v = x.reshape(-1, 3)
+            steps = np.vstack([v[0] - yhat, np.diff(v, axis=0)])
+            return control.d_max_support_m**2 - np.sum(steps**2, axis=1)
+
+        start = time.perf_counter()
+        reference = minimize(
+            cost,
+            mpc._initial_guess(yhat, terminal, None).ravel(),
+            method="SLSQP",
+            options={"maxiter": 300, "ftol": 1e-12},
+            constraints=[{"type": "ineq", "fun": steps_left}],
+        )
+        scipy_s = time.perf_counter() - start
+        if np.max(np.abs(reference.x.reshape(-1, 3) - result.path)) <= 0.01:
+            ratios.append(scipy_s / casadi_s)
+    return statistics.median(ratios) if ratios else float("nan")
+
+
+def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchResult]:
+    """Lockstep runs, each a ``python -m mission run`` process as a user or a batch starts it:
+    Along AC's real-time factor, the median of ``repeats`` runs (MPC helper where there is a
+    core for it); and the wall time of the full Table 3 batch, estimated as trials x (sum of
+    one run per scenario and method, made as the batch makes them) / jobs."""
+    import tempfile
+
+    from mission.runs.batch import helper_has_a_core
+
+    factors, walls = [], []
+    in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)
+    with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
+        for repeat in range(repeats):
+            out = Path(temp) / f"along-ac-{repeat}"
+            factors.append(run_as_command("along", "ac", out)["realtime_factor"])
+        for name in ("along", "wall"):
+            for method in ("ac", "nac"):
+                out = Path(temp) / f"batch-{name}-{method}"
+                walls.append(run_as_command(name, method, out, in_batch)["wall_time_s"])
+    factor = statistics.median(factors)
+    estimate = trials * sum(walls) / jobs
+    return [
+        BenchResult("realtime_factor_lockstep", factor, "x", ">= 30", factor >= 30),
+        BenchResult("table3_wall_s_estimate", estimate, "s", "<= 600", estimate <= 600),
+    ]
+
+
+def run_as_command(
+    scenario: str, method: str, out: Path, mpc_helper: bool | None = None
+) -> dict[str, Any]:
+    """The summary of ``python -m mission run SCENARIO --method METHOD --seed 0 --out OUT``
+    (a fresh process: this one may have threads that keep it from forking vehicles)."""
+    import json
+
+    helper = [] if mpc_helper is None else ["--mpc-helper" if mpc_helper else "--no-mpc-helper"]
+    command = [sys.executable, "-m", "mission", "run", scenario, "--method", method]
+    subprocess.run(
+        [*command, "--seed", "0", "--out", str(out), *helper],
+        check=True,
+        stdout=subprocess.DEVNULL,
+    )
+    return json.loads((out / "summary.json").read_text())
+
+
+BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
+    "world": bench_sigma0_map,
+    "vehicle": bench_vehicle,
+    "gcs": bench_ground_station,
+    "run": bench_runs,
+}
+
+
+def bench_machine_speed(repeats: int = 5) -> BenchResult:
+    """CPU seconds of a fixed pure-Python loop: how fast this machine is right now (a shared
+    VM's speed drifts by tens of per cent within hours, and every other row moves with it)."""
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        sum(range(10_000_000))
+        times.append(time.process_time() - start)
+    return BenchResult("machine_python_loop_s", statistics.median(times), "s", "reference", None)
+
+
+def run_benchmarks(only: list[str] | None = None) -> list[BenchResult]:
+    """Run the chosen benchmark groups (all by default), after the machine's speed."""
+    results: list[BenchResult] = [bench_machine_speed()]
+    for name, bench in BENCHMARKS.items():
+        if only is None or name in only:
+            results.extend(bench())
+    return results
+
+
+def format_table(results: list[BenchResult]) -> str:
+    """A plain-text table of results."""
+    lines = [f"{'benchmark':<32} {'value':>12} {'unit':<8} {'target':<10} ok"]
+    lines += [
+        f"{r.name:<32} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {_verdict(r.ok)}"
+        for r in results
+    ]
+    return "\n".join(lines)
+
+
+def _verdict(ok: bool | None) -> str:
+    return "-" if ok is None else "yes" if ok else "NO"

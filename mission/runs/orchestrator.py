@@ -1,0 +1,246 @@
+"""``mission run``: one process per vehicle and a ground station, on free loopback ports.
+
+The ground station is forked first (:mod:`mission.procs.forked`) and imports its own code; meanwhile
+this process imports the vehicle simulator once and forks the four vehicles. Where forking is
+not safe, or ``process_start="exec"`` asks for it, each is started as ``python -m
+ground_station`` or ``python -m vehicle_sim`` instead. Either way the results are the same.
+
+Children write their stderr to ``DIR/<name>.log``; all of them are stopped when the run ends,
+fails, or is interrupted, and die with this process if it is killed (``--exit-with-parent``).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from mission.analysis.metrics import analyze_tlog, mpc_stats
+from mission.config.settings import Scenario
+from mission.link.impairment import LinkSettings
+from mission.link.plan_files import vehicle_names
+from mission.procs.atomic import write_text_atomically
+from mission.procs.cli_common import child_environment
+from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
+
+_BANNER = re.compile(r"listening on [\d.]+:(\d+)")
+SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
+
+
+class RunFailed(RuntimeError):
+    """A child process died or a run could not start; names the process."""
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What to run and where."""
+
+    scenario: str
+    method: str
+    seed: int
+    out_dir: Path
+    speedup: float | None = None
+    signing_key: Path | None = None  # the key file, passed to every process
+    observer: str | None = None  # HOST:PORT every vehicle also streams to
+    link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
+    mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
+    process_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
+
+    def __post_init__(self) -> None:
+        if self.process_start not in ("fork", "exec"):
+            raise ValueError(f"process_start must be fork or exec, not {self.process_start!r}")
+
+
+@dataclass
+class Child:
+    """A started child process and its log."""
+
+    name: str
+    process: subprocess.Popen | ForkedProcess
+    log: Path
+
+
+def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
+    """Run a mission to completion or timeout; return its summary (also in summary.json)."""
+    options.out_dir.mkdir(parents=True, exist_ok=True)
+    children: list[Child] = []
+    start = time.monotonic()
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        pacing = ["--speedup", str(options.speedup)] if options.speedup else []
+        if options.signing_key is not None:
+            pacing += ["--signing-key", str(options.signing_key)]
+        observer = ["--out", options.observer] if options.observer else []
+        if options.link.impaired:
+            pacing += ["--link-loss", str(options.link.loss)]
+            pacing += ["--link-delay-ms", str(options.link.delay_ms)]
+        common = [
+            "--scenario",
+            options.scenario,
+            "--seed",
+            str(options.seed),
+            *pacing,
+            "--exit-with-parent",
+        ]
+        names = vehicle_names(scenario.task.supports)
+        # Every socket is bound here and inherited, so the ground station starts first knowing
+        # every address, before any vehicle has printed its banner.
+        sockets = {name: _bound_udp() for name in names}
+        truth_sockets = {name: _bound_udp() for name in names[1:]}
+        truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
+        addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
+        helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
+        forking = options.process_start == "fork" and fork_is_safe()
+        station = ["--method", options.method, "--vehicles", addresses]
+        station += ["--out", str(options.out_dir), *helper, *common]
+        gcs = _launch(
+            options.out_dir,
+            "ground_station",
+            station,
+            (),
+            _ground_station_main if forking else None,
+        )
+        children.append(gcs)
+        vehicle_main = _vehicle_main() if forking else None
+        for name in names:
+            fds = [sockets[name].fileno()]
+            arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
+            if name in truth_sockets:
+                fds.append(truth_sockets[name].fileno())
+                arguments += ["--truth-socket-fd", str(fds[1])]
+            else:
+                arguments += truth_out
+            arguments += [*observer, *common]
+            children.append(_launch(options.out_dir, name, arguments, fds, vehicle_main))
+        for sock in (*sockets.values(), *truth_sockets.values()):
+            sock.close()  # the children hold them now
+        _supervise(gcs, children, required={"work"})
+        if gcs.process.returncode != 0:
+            raise RunFailed(
+                f"ground_station exited with status {gcs.process.returncode} (see {gcs.log})"
+            )
+    finally:
+        _stop_all(children)
+        signal.signal(signal.SIGTERM, previous)
+    wall = time.monotonic() - start
+    summary = {
+        "scenario": scenario.name,
+        "scenario_source": scenario.source,
+        "method": options.method,
+        "seed": options.seed,
+        **analyze_tlog(options.out_dir / "gcs.tlog", scenario),
+    }
+    simulated = (summary["control_cycles"] or 0) * scenario.control.t_cont_s
+    summary["wall_time_s"] = round(wall, 3)
+    summary["realtime_factor"] = round(simulated / wall, 3) if wall > 0 else None
+    summary["mpc_solve_ms"] = mpc_stats(options.out_dir / "records.jsonl")
+    link_file = options.out_dir / "link.json"
+    if link_file.is_file():
+        summary["link"] = json.loads(link_file.read_text())
+    write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
+    return summary
+
+
+def _vehicle_main() -> Callable[[list[str]], int]:
+    """The vehicles' entry point, imported here once for the four forks."""
+    from vehicle_sim.cli import entry_point
+
+    return entry_point
+
+
+def _ground_station_main(argv: list[str]) -> int:
+    """The forked ground station: it imports its own code (casadi and the MPCs), while this
+    process goes on to the vehicles."""
+    from ground_station.cli import entry_point
+
+    return entry_point(argv)
+
+
+def _flag(name: str, on: bool) -> str:
+    """--NAME or --no-NAME."""
+    return f"--{name}" if on else f"--no-{name}"
+
+
+def _raise_interrupt(*_: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def _bound_udp() -> socket.socket:
+    """A UDP socket bound to a free loopback port."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    return sock
+
+
+def _address_of(sock: socket.socket) -> str:
+    host, port = sock.getsockname()[:2]
+    return f"{host}:{port}"
+
+
+def _launch(
+    out_dir: Path,
+    name: str,
+    arguments: list[str],
+    pass_fds: Sequence[int],
+    forked_main: Callable[[list[str]], int] | None,
+) -> Child:
+    """Start the ground station or a vehicle (``name``) with ``arguments``: forked to run
+    ``forked_main``, or, without one, as ``python -m <its package>``."""
+    log = out_dir / f"{name}.log"
+    if forked_main is not None:
+        forked = start_forked(forked_main, arguments, log, pass_fds, child_environment())
+        return Child(name, forked, log)
+    module = "ground_station" if name == "ground_station" else "vehicle_sim"
+    handle = log.open("w")
+    process = subprocess.Popen(
+        [sys.executable, "-m", module, *arguments],
+        stdout=handle,
+        stderr=handle,
+        stdin=subprocess.DEVNULL,
+        env=child_environment(),
+        pass_fds=tuple(pass_fds),
+    )
+    handle.close()
+    return Child(name, process, log)
+
+
+def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
+    """Wait for the ground station; a dead required vehicle, or one that never started,
+    ends the run with an error."""
+    while True:
+        try:
+            gcs.process.wait(timeout=SUPERVISE_S)
+            return
+        except subprocess.TimeoutExpired:
+            pass
+        for child in children:
+            if child is gcs or child.process.poll() is None:
+                continue
+            if not _BANNER.search(child.log.read_text()):
+                tail = child.log.read_text().strip().splitlines()[-1:] or ["no output"]
+                raise RunFailed(f"{child.name} did not start: {tail[0]}")
+            if child.name in required:
+                raise RunFailed(
+                    f"{child.name} died (exit status {child.process.returncode}, see {child.log})"
+                )
+
+
+def _stop_all(children: list[Child]) -> None:
+    for child in children:
+        if child.process.poll() is None:
+            child.process.terminate()
+    deadline = time.monotonic() + 10
+    for child in children:
+        try:
+            child.process.wait(timeout=max(0.1, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            child.process.kill()
+            child.process.wait()

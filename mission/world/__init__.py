@@ -1,0 +1,1 @@
+"""World model: structure, rays, sky, GNSS, camera, frames, grid, zones. Imports: config."""

@@ -1,0 +1,49 @@
+"""A regular voxel grid over the workspace box (the support of the map G)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.config.settings import Box
+
+
+@dataclass(frozen=True)
+class VoxelGrid:
+    """Voxels of side ``voxel_m`` tiling the workspace from its min corner."""
+
+    origin_m: np.ndarray
+    voxel_m: float
+    shape: tuple[int, int, int]
+
+    @classmethod
+    def over(cls, box: Box, voxel_m: float) -> VoxelGrid:
+        """Grid covering ``box``; a partial voxel at the far faces is dropped."""
+        size = np.array(box.size_m)
+        shape = tuple(max(1, int(np.floor(s / voxel_m + 1e-9))) for s in size)
+        return cls(np.array(box.min_m, dtype=float), float(voxel_m), shape)  # type: ignore[arg-type]
+
+    @property
+    def n_voxels(self) -> int:
+        """Number of voxels."""
+        return int(np.prod(self.shape))
+
+    def axis_centers(self, axis: int) -> np.ndarray:
+        """Centre coordinates along one axis."""
+        return self.origin_m[axis] + self.voxel_m * (np.arange(self.shape[axis]) + 0.5)
+
+    def centers(self) -> np.ndarray:
+        """(nx, ny, nz, 3) voxel centres."""
+        grids = np.meshgrid(*(self.axis_centers(a) for a in range(3)), indexing="ij")
+        return np.stack(grids, axis=-1)
+
+    def index_of(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) integer index of the voxel containing each point, clipped to the grid."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        index = np.floor((points - self.origin_m) / self.voxel_m).astype(int)
+        return np.clip(index, 0, np.array(self.shape) - 1)
+
+    def center_of(self, index: np.ndarray) -> np.ndarray:
+        """Centre of the voxel(s) with the given integer index."""
+        return self.origin_m + self.voxel_m * (np.asarray(index, dtype=float) + 0.5)
