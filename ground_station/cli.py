@@ -11,15 +11,14 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.link.impairment import add_link_arguments, link_settings
 from mission.link.mavlink_udp import parse_address
 from mission.link.plan_files import vehicle_names
 from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
 from mission.procs.cli_common import (
     OneLineArgumentParser,
-    add_link_arguments,
     die_with_parent,
-    link_settings,
     name_this_process,
     run_guarded,
 )

@@ -11,10 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from mission.config.errors import InputError
+from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import (
     OneLineArgumentParser,
-    add_link_arguments,
-    link_settings,
     parse_point,
     run_guarded,
 )

@@ -10,15 +10,14 @@ from pathlib import Path
 import numpy as np
 
 from mission.config.errors import InputError
+from mission.link.impairment import add_link_arguments, link_settings
 from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.link.plan_files import read_vehicle_waypoints
 from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
 from mission.procs.cli_common import (
     OneLineArgumentParser,
-    add_link_arguments,
     freeze_startup_heap,
-    link_settings,
     name_this_process,
     parse_point,
     run_guarded,

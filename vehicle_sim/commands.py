@@ -3,14 +3,26 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from vehicle_sim import modes
+from vehicle_sim.mission_server import MissionServer
 
-if TYPE_CHECKING:
-    from vehicle_sim.vehicle import Vehicle
+
+class Vehicle(Protocol):
+    """What the commands act on (:class:`vehicle_sim.vehicle.Vehicle`)."""
+
+    intervals_s: dict[int, float | None]
+    mission: MissionServer
+
+    def send(self, message: Any) -> None: ...
+    def arm(self, armed: bool) -> None: ...
+    def change_mode(self, mode: int) -> None: ...
+    def set_interval(self, message_id: int, interval_us: float) -> bool: ...
+    def build_stream(self, message_id: int, work_truth: Any = None) -> Any: ...
+
 
 ACCEPTED = mavlink2.MAV_RESULT_ACCEPTED
 DENIED = mavlink2.MAV_RESULT_DENIED

@@ -21,6 +21,7 @@ from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
 from vehicle_sim import modes, telemetry
+from vehicle_sim.commands import execute, set_mode
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
 
@@ -358,8 +359,6 @@ class Vehicle:
         self.kinematics.set_estimate(ned_to_enu(np.array(values, dtype=float)))
 
     def _on_command(self, msg: Any) -> None:
-        from vehicle_sim.commands import execute
-
         params = [msg.param1, msg.param2, msg.param3, msg.param4]
         if msg.get_type() == "COMMAND_LONG":
             params += [msg.param5, msg.param6, msg.param7]
@@ -373,8 +372,6 @@ class Vehicle:
         )
 
     def _on_set_mode(self, msg: Any) -> None:
-        from vehicle_sim.commands import set_mode
-
         result = set_mode(self, int(msg.base_mode), int(msg.custom_mode))
         self.send(
             mavlink2.MAVLink_command_ack_message(

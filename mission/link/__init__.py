@@ -1,1 +1,1 @@
-"""The MAVLink layer of both sides, waypoint and plan files. Imports: config, world."""
+"""The MAVLink layer of both sides, waypoint and plan files. Imports: config, world, procs."""

@@ -8,6 +8,7 @@ the same traffic); delayed datagrams leave from one background thread, in order.
 
 from __future__ import annotations
 
+import argparse
 import heapq
 import itertools
 import socket
@@ -16,6 +17,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+
+from mission.config.errors import InputError
 
 Address = tuple[str, int]
 
@@ -102,3 +105,30 @@ class ImpairedLink:
                     return
                 _, _, datagram, destination = heapq.heappop(self._queue)
             self._sendto(datagram, destination)
+
+
+def add_link_arguments(parser: argparse.ArgumentParser) -> None:
+    """--link-loss P and --link-delay-ms D (testing: impair every datagram this process sends)."""
+    parser.add_argument(
+        "--link-loss",
+        type=float,
+        default=0.0,
+        metavar="P",
+        help="drop each datagram sent with probability P (seeded; testing)",
+    )
+    parser.add_argument(
+        "--link-delay-ms",
+        type=float,
+        default=0.0,
+        metavar="D",
+        help="delay each datagram sent by D milliseconds (testing)",
+    )
+
+
+def link_settings(args: argparse.Namespace) -> LinkSettings:
+    """--link-loss and --link-delay-ms, checked."""
+    try:
+        return LinkSettings(args.link_loss, args.link_delay_ms)
+    except ValueError as error:
+        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
+        raise InputError("command line", flag, str(error).split(" ", 1)[1]) from None

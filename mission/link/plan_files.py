@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +15,15 @@ from mission.link.waypoints import (
     waypoint_rows_from_enu,
     write_waypoints,
 )
-from mission.planning.planner import Plan
 from mission.world.frames import GeodeticFrame
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Work waypoints (I, 3) and support waypoints (N, I, 3), ENU metres."""
+
+    work: np.ndarray
+    supports: np.ndarray
 
 
 def vehicle_names(supports: int) -> list[str]:

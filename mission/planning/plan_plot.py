@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from mission.analysis.world_plot import draw_background
-from mission.planning.planner import Plan
+from mission.link.plan_files import Plan
 from mission.procs.atomic import write_atomically
 from mission.world.model import World
 

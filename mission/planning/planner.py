@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mission.config.errors import InputError
+from mission.link.plan_files import Plan
 from mission.world.grid import VoxelGrid
 from mission.world.model import World
 
@@ -29,14 +30,6 @@ CANDIDATES_PER_INDEX = 1000
 
 class PlanningError(InputError):
     """The scenario's task cannot be planned; names the waypoint and the reason."""
-
-
-@dataclass(frozen=True)
-class Plan:
-    """Work waypoints (I, 3) and support waypoints (N, I, 3), ENU metres."""
-
-    work: np.ndarray
-    supports: np.ndarray
 
 
 @dataclass(frozen=True)

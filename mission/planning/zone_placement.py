@@ -14,7 +14,7 @@ import itertools
 import numpy as np
 
 from mission.config.settings import Box
-from mission.planning.planner import Plan
+from mission.link.plan_files import Plan
 
 GRID_M = 0.5
 SAMPLE_M = 0.05

@@ -1,1 +1,1 @@
-"""Process helpers: forks, names, one-line CLI errors, atomic writes. Imports: config, link."""
+"""Process helpers: forks, names, one-line CLI errors, atomic writes. Imports: config."""

@@ -8,7 +8,6 @@ import sys
 from collections.abc import Callable, Sequence
 
 from mission.config.errors import InputError
-from mission.link.impairment import LinkSettings
 
 EXIT_BAD_INPUT = 2
 
@@ -90,30 +89,3 @@ def die_with_parent() -> None:
         parent = os.environ.get(PARENT_PID_VARIABLE)
         if parent is not None and parent.isdigit() and os.getppid() != int(parent):
             os.kill(os.getpid(), signal.SIGTERM)  # the parent died before prctl took effect
-
-
-def add_link_arguments(parser: argparse.ArgumentParser) -> None:
-    """--link-loss P and --link-delay-ms D (testing: impair every datagram this process sends)."""
-    parser.add_argument(
-        "--link-loss",
-        type=float,
-        default=0.0,
-        metavar="P",
-        help="drop each datagram sent with probability P (seeded; testing)",
-    )
-    parser.add_argument(
-        "--link-delay-ms",
-        type=float,
-        default=0.0,
-        metavar="D",
-        help="delay each datagram sent by D milliseconds (testing)",
-    )
-
-
-def link_settings(args: argparse.Namespace) -> LinkSettings:
-    """--link-loss and --link-delay-ms, checked."""
-    try:
-        return LinkSettings(args.link_loss, args.link_delay_ms)
-    except ValueError as error:
-        flag = "--link-loss" if "loss" in str(error) else "--link-delay-ms"
-        raise InputError("command line", flag, str(error).split(" ", 1)[1]) from None

@@ -22,23 +22,9 @@ from typing import Any, TextIO
 
 from mission.procs.cli_common import child_environment
 from mission.runs.batch_table import write_tables
+from mission.runs.trials import Trial
 
 POLL_S = 0.2
-
-
-@dataclass(frozen=True)
-class Trial:
-    """One run of a batch."""
-
-    scenario: str  # as given: an embedded name or a YAML path
-    scenario_name: str  # the scenario's own name, for directories and tables
-    method: str
-    seed: int
-
-    @property
-    def key(self) -> str:
-        """The run's directory name."""
-        return f"{self.scenario_name}-{self.method}-{self.seed}"
 
 
 @dataclass(frozen=True)

@@ -15,12 +15,10 @@ import statistics
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from mission.procs.atomic import write_atomically, write_text_atomically
-
-if TYPE_CHECKING:
-    from mission.runs.batch import Trial
+from mission.runs.trials import Trial
 
 RESULT_COLUMNS = [
     "scenario",
