@@ -22,7 +22,7 @@ from mission.procs.cli_common import (
     name_this_process,
     run_guarded,
 )
-from mission.world.model import World
+from mission.world.model import KnownWorld
 
 
 def build_parser() -> OneLineArgumentParser:
@@ -99,14 +99,15 @@ def read_waypoints_file(path: Path) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a mission and print its summary as JSON."""
-    from ground_station.station import GroundStation, StationConfig, StationError
+    from ground_station.links import StationError
+    from ground_station.station import GroundStation, StationConfig
     from ground_station.support_planning import HelperError
 
     args = build_parser().parse_args(argv)
     name_this_process("ground_station")  # forked by `mission run`, it has no own argv
     if args.exit_with_parent:
         die_with_parent()
-    world = World.load(args.scenario)
+    world = KnownWorld.load(args.scenario)
     scenario = world.scenario
     vehicles = _vehicle_addresses(args, scenario.task.supports)
     if args.speedup is not None and not 0 < args.speedup <= 1000:
@@ -130,7 +131,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         mpc_helper=args.mpc_helper,
     )
     station = GroundStation(world, config)
-    host, port = station.endpoint.address
+    host, port = station.links.endpoint.address
     print(f"ground station listening on {host}:{port}", file=sys.stderr, flush=True)
     try:
         summary = station.run()

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ground_station.state import StationState
 from mission.config.settings import FusionSettings
 
 
@@ -92,6 +93,29 @@ class LogDensity:
 def log_gaussian(x: np.ndarray, mu: np.ndarray, sigma: np.ndarray) -> np.ndarray:
     """log N(x; mu, sigma) for rows of x."""
     return LogDensity.of(mu, sigma)(x)
+
+
+def fuse(
+    state: StationState,
+    supports: list[SupportMeasurement],
+    settings: FusionSettings,
+    rng: np.random.Generator,
+) -> tuple[FusionResult, dict[str, float | None]]:
+    """Step 2 of the control cycle: selective fusion for xhat around the position predicted
+    from the last command, then feedback to each support's yhat_n; updates ``state`` and
+    returns the fusion and each support's beta_n."""
+    predicted = state.xhat + state.last_work_command
+    fusion = selective_fusion(supports, predicted, settings, rng)
+    if fusion.xhat is not None:
+        state.xhat = fusion.xhat
+    betas: dict[str, float | None] = {}
+    for support in supports:
+        previous = state.yhat[support.name]
+        moved = state.last_support_command.get(support.name, np.zeros(3))
+        result = support_feedback(support, fusion, previous, moved)
+        state.yhat[support.name] = result.yhat
+        betas[support.name] = result.beta
+    return fusion, betas
 
 
 def selective_fusion(

@@ -10,10 +10,12 @@ i + s(t), s(t) = 3t^2 - 2t^3; outside the grid it takes the nearest border value
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 
 import casadi as ca
 import numpy as np
 
+from ground_station.fusion import SupportMeasurement
 from mission.config.settings import MapSettings
 from mission.world.grid import VoxelGrid
 
@@ -64,6 +66,19 @@ class LocalizabilityMap:
     def flat_values(self) -> np.ndarray:
         """Values in the order the casadi interpolant expects (first axis fastest)."""
         return self.values.ravel(order="F")
+
+
+def learn(
+    g: LocalizabilityMap, measurements: Sequence[SupportMeasurement], yhat: dict[str, np.ndarray]
+) -> int:
+    """Step 4 of the control cycle: G updated around each support's yhat_n with its GNSS error
+    |p_n - yhat_n|, for the supports with both a fix and an observation (without one, yhat_n is
+    p_n and says nothing about the error); returns how many voxel updates were made."""
+    updated = 0
+    for support in measurements:
+        if support.fix_m is not None and support.relative_m is not None:
+            updated += g.update(support.fix_m, yhat[support.name])
+    return updated
 
 
 def warped_index(u: np.ndarray | ca.MX | ca.SX, upper: np.ndarray) -> np.ndarray | ca.MX | ca.SX:

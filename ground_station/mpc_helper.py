@@ -50,13 +50,13 @@ def serve(requests: BinaryIO, answers: BinaryIO) -> None:
     """Build the solver from the first frame, then answer request lists until end of input."""
     from ground_station.support_mpc import SupportMpc
     from mission.procs.cli_common import freeze_startup_heap
-    from mission.world.model import World
+    from mission.world.model import KnownWorld
 
     try:
         scenario, sigma0 = read_frame(requests)
     except EOFError:
         return
-    world = World(scenario)
+    world = KnownWorld(scenario)
     mpc = SupportMpc(scenario.control, world.map_grid(), world.camera, sigma0)
     freeze_startup_heap()
     while True:

@@ -1,12 +1,5 @@
-"""MPC of each support UAV (paper 4.2.2): casadi + fatrop (or IPOPT), built once per run.
-
-Decision variables: the U predicted positions V'_n. Cost, exactly the paper's four terms:
-
-  C_GNSS     = sum_u w_GNSS G_s(v_u)
-  C_interval = xi(|yhat - v_1|) + sum_u xi(|v_{u+1} - v_u|) + xi(|w_{n,k_{U+1}} - v_U|),
-               xi(d) = w_interval d^2 if d <= d_max else w_penalty d^2
-  C_waypoint = sum_u w_waypoint |v_u - w_{n,k_u}|^2
-  C_relative = sum_u (w_relative, or w_penalty if not observable) |v^(w)_u - v_u|^2
+"""MPC of each support UAV (paper 4.2.2): its NLP (:mod:`ground_station.support_nlp`) solved
+with casadi + fatrop (or IPOPT), built once per run, for any support with its own parameters.
 
 Observability (range and line of sight between V^(w)_u and v_u) is not differentiable: it is
 evaluated on the initial guess (the previous solution shifted by one step), held fixed during
@@ -25,170 +18,19 @@ min G), or when the terminal is out of reach, where only far is feasible.
 
 from __future__ import annotations
 
-import contextlib
-import hashlib
-import itertools
-import os
-import shutil
-import subprocess
-import tempfile
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
-import casadi as ca
 import numpy as np
 
-from ground_station.casadi_buffer import BufferedFunction
-from ground_station.localizability import hermite_zero_slope, inlined_hermite
+from ground_station.los_anchors import LosAnchors
+from ground_station.support_nlp import build_support_nlp
 from mission.config.settings import ControlSettings
 from mission.world.camera import CameraModel
 from mission.world.grid import VoxelGrid
 
-IPOPT_OPTIONS = {
-    "ipopt.print_level": 0,
-    "ipopt.sb": "yes",
-    "print_time": False,
-    "calc_lam_p": False,  # unused; its gradient over the G window costs more than the solve
-    "ipopt.max_iter": 50,
-    "ipopt.tol": 1e-4,  # positions to ~0.1 mm; 1e-6 cost 25 % more iterations for nothing
-    "ipopt.acceptable_tol": 1e-4,
-    "ipopt.warm_start_init_point": "yes",
-    "ipopt.hessian_approximation": "exact",  # measured: 3x fewer ms than L-BFGS here
-    # MUMPS's matching-based permutation and scaling are for hard large systems; here they
-    # cost 5 % of a solve and change the solutions by 1e-14 (600 recorded problems)
-    "ipopt.mumps_permuting_scaling": 0,
-}
-# fatrop runs IPOPT's algorithm (filter line search, same barrier defaults) without IPOPT's
-# per-solve set-up of its objects and of MUMPS, which is ~90 % of a 15-variable solve: 3x
-# fewer ms. One dense stage ("none") is all 15 variables need.
-FATROP_OPTIONS = {
-    "structure_detection": "none",
-    "print_time": False,
-    "calc_lam_p": False,
-    # bound_push as IPOPT's warm start has it: the guess is the previous plan, shifted
-    "fatrop": {"print_level": 0, "tol": 1e-4, "max_iter": 50, "bound_push": 1e-3},
-}
-SOLVER_OPTIONS = {"fatrop": FATROP_OPTIONS, "ipopt": IPOPT_OPTIONS}
-# -O1: as fast a solve as -O2 (1,220 recorded solves, bit-identical results) and the
-# generated ~1.2 MB of C compiles in 5.8 s instead of 8.6 s
-COMPILE_FLAGS = ["-O1", "-fPIC", "-shared"]
 ESCAPE_STARTS = 1  # escape starts solved: the cheapest of six where it starts
 CONVERGED = "SOLVER_RET_SUCCESS"  # casadi's status for a solve that met its tolerance
-
-
-@dataclass(frozen=True)
-class NlpBuild:
-    """One NLP to compile: the solver's name and casadi plugin, the NLP (keys x, p, f, g) and
-    the solver's options."""
-
-    name: str
-    plugin: str
-    nlp: dict[str, ca.MX]
-    options: dict
-
-
-def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> list[str | None]:
-    """For each build, the functions its casadi solver needs, compiled into a shared library
-    with the system C compiler (about 1.5x faster solves than interpreting them), or None
-    without one. The libraries not yet cached are compiled at the same time, one compiler
-    process each.
-
-    A library is cached (under ``$XDG_CACHE_HOME`` or ``~/.cache``) by the hash of the
-    serialised NLP, the solver's name, plugin and options, the casadi version, the compiler
-    and its flags: a run after the first builds no solver from the expressions, generates no
-    C and compiles nothing. The C sources are generated in a scratch directory that is gone on
-    return; where the cache cannot be written, the libraries go to ``fallback_dir()``.
-    """
-    compiler = shutil.which("gcc") or shutil.which("cc")
-    libraries: list[str | None] = [None] * len(builds)
-    if compiler is None:
-        return libraries
-    missing: dict[int, str] = {}
-    for index, build in enumerate(builds):
-        library_name = _library_name(compiler, build)
-        cached = _cache_dir() / library_name
-        if cached.is_file():
-            libraries[index] = str(cached)
-        else:
-            missing[index] = library_name
-    if not missing:
-        return libraries
-    with tempfile.TemporaryDirectory(prefix="support-mpc-c-") as scratch:
-        sources: dict[int, tuple[str, Path]] = {}
-        for index, library_name in missing.items():
-            build = builds[index]
-            solver = ca.nlpsol(build.name, build.plugin, build.nlp, build.options)
-            source = f"support_mpc_nlp{index}.c"  # its stem must be a C identifier
-            with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
-                solver.generate_dependencies(source)
-            sources[index] = (library_name, Path(scratch) / source)
-        for directory_of in (_cache_dir, lambda: Path(fallback_dir())):
-            if not sources:
-                break
-            try:
-                directory = directory_of()
-                directory.mkdir(parents=True, exist_ok=True)
-            except OSError:
-                continue
-            for index, library in _compile_all(compiler, sources, directory).items():
-                libraries[index] = library
-                del sources[index]
-    return libraries
-
-
-def _library_name(compiler: str, build: NlpBuild) -> str:
-    nlp = build.nlp
-    functions = ca.Function("nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
-    recipe = "\n".join(
-        [
-            f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}",
-            build.name,
-            build.plugin,
-            repr(sorted(build.options.items())),
-            functions.serialize(),
-        ]
-    )
-    return f"support_mpc_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
-
-
-def _compile_all(
-    compiler: str, sources: dict[int, tuple[str, Path]], directory: Path
-) -> dict[int, str]:
-    """Compile every source into ``directory`` at once; the libraries that were made, by
-    index. A library appears under its name only when complete."""
-    running: dict[int, tuple[subprocess.Popen, Path, Path]] = {}
-    made: dict[int, str] = {}
-    try:
-        for index, (library_name, source) in sources.items():
-            partial = directory / f".{library_name}.{os.getpid()}.part"
-            command = [compiler, *COMPILE_FLAGS, str(source), "-o", str(partial)]
-            with contextlib.suppress(OSError):
-                process = subprocess.Popen(
-                    command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
-                )
-                running[index] = (process, partial, directory / library_name)
-        for index, (process, partial, library) in running.items():
-            try:
-                if process.wait() == 0:
-                    os.replace(partial, library)
-                    made[index] = str(library)
-            except OSError:
-                pass
-            finally:
-                partial.unlink(missing_ok=True)
-    finally:
-        for process, _, _ in running.values():  # interrupted: no compiler outlives us
-            if process.poll() is None:
-                process.kill()
-                process.wait()
-    return made
-
-
-def _cache_dir() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "bridge-uav-formation"
 
 
 @dataclass(frozen=True)
@@ -251,12 +93,9 @@ class SupportMpc:
         half = int(np.ceil(reach / grid.voxel_m))
         self.window = tuple(min(2 * half + 1, n) for n in grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
-        self._solvers, self._cost = self._build()
-        cube = np.array(list(itertools.product((-1.0, 0.0, 1.0), repeat=3)))
-        cube = cube[np.any(cube != 0, axis=1)]
-        self._directions = cube / np.linalg.norm(cube, axis=1, keepdims=True)
-        reach = control.horizon_steps * control.d_max_support_m
-        self._shell_radii = np.arange(0.5, reach + 1e-9, 0.5)
+        nlp = build_support_nlp(control, self._window_grid, with_prior=sigma0 is not None)
+        self._solvers, self._cost = nlp.solvers, nlp.cost
+        self._anchors = LosAnchors(control, camera, grid, self.sigma0)
         d_max_sq = control.d_max_support_m**2
         steps = np.full(self.horizon, d_max_sq * (1 + 1e-6))
         shadow = np.full(0 if sigma0 is None else self.horizon, control.support_max_sigma0_m)
@@ -266,102 +105,6 @@ class SupportMpc:
             "near": np.concatenate([steps, [d_max_sq * (1 - 1e-6)], shadow]),
             "far": np.concatenate([steps, shadow]),
         }
-
-    def _build(self) -> tuple[dict[str, BufferedFunction], BufferedFunction]:
-        """The solvers of the near and far branches (their functions compiled when a C
-        compiler is there) and the cost function."""
-        c, horizon = self.control, self.horizon
-        sym = ca.MX
-        v = sym.sym("v", 3, horizon)
-        yhat = sym.sym("yhat", 3)
-        targets = sym.sym("w", 3, horizon)
-        terminal = sym.sym("terminal", 3)
-        work = sym.sym("vw", 3, horizon)
-        anchors = sym.sym("q", 3, horizon)  # where a blocked step is pulled (see _anchors)
-        blocked = sym.sym("blocked", horizon)
-        values = sym.sym("G", self._window_grid.n_voxels)
-        prior = sym.sym("sigma0", 0 if self.sigma0 is None else self._window_grid.n_voxels)
-        corner = sym.sym("corner", 3)
-
-        terminal_weight = sym.sym("w_terminal")  # xi's weight on the branch being solved
-
-        def sq(a):
-            return ca.sumsqr(a)
-
-        hermite = inlined_hermite(self._window_grid)  # G_s and the prior's, per step
-
-        # Steps are also bounded hard (below), where xi(d) = w_interval d^2 exactly: writing it
-        # so keeps the cost smooth. The terminal link is solved per branch (module docstring).
-        cost = c.w_interval * sq(yhat - v[:, 0])
-        for u in range(horizon):
-            cost += c.w_gnss * hermite(v[:, u] - corner, values)
-            cost += c.w_waypoint * sq(v[:, u] - targets[:, u])
-            cost += (1 - blocked[u]) * c.w_relative * sq(work[:, u] - v[:, u])
-            cost += blocked[u] * c.w_penalty * sq(anchors[:, u] - v[:, u])
-            if u + 1 < horizon:
-                cost += c.w_interval * sq(v[:, u + 1] - v[:, u])
-        terminal_sq = sq(terminal - v[:, horizon - 1])
-        cost += terminal_weight * terminal_sq
-        parameters = ca.vertcat(
-            yhat,
-            ca.vec(targets),
-            terminal,
-            ca.vec(work),
-            terminal_weight,
-            ca.vec(anchors),
-            blocked,
-            corner,
-            values,
-            prior,
-        )
-        # The vehicle cannot fly faster than s_max: each predicted step is also bounded hard
-        # (the paper's penalty alone lets a discontinuous cost trap the solver beyond d_max).
-        steps = [sq(v[:, 0] - yhat)] + [sq(v[:, u + 1] - v[:, u]) for u in range(horizon - 1)]
-        # Stay where the prior map (structure and sky, no zones) predicts a usable fix: the
-        # paper's LOS penalty pulls a blocked support straight at the work UAV, i.e. under the
-        # deck, where it would lose its fix (and fly into the structure).
-        shadow = (
-            []
-            if self.sigma0 is None
-            else [hermite(v[:, u] - corner, prior) for u in range(horizon)]
-        )
-        cost_function = ca.Function(
-            "support_mpc_cost", [ca.vec(v), parameters], [cost], ["x", "p"], ["f"]
-        )
-        # With an infinite bound on far's terminal row fatrop failed 99 of 1,220 recorded
-        # solves and carried the failure into the solves after it (plans then depended on the
-        # order of solving); without the row it solves them all, as IPOPT does. No bound of
-        # either branch is infinite.
-        constraints = {
-            "near": ca.vertcat(*steps, terminal_sq, *shadow),
-            "far": ca.vertcat(*steps, *shadow),
-        }
-        plugin = c.mpc_solver
-        options = SOLVER_OPTIONS[plugin]
-        unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
-        builds = [
-            NlpBuild(
-                f"support_mpc_{branch}",
-                plugin,
-                {"x": ca.vec(v), "p": parameters, "f": cost, "g": g},
-                options,
-            )
-            for branch, g in constraints.items()
-        ]
-        solvers = {}
-        with contextlib.ExitStack() as scratch:  # for libraries the cache cannot take
-
-            def private_directory() -> str:
-                return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
-
-            libraries = compiled_nlps(builds, private_directory)
-            for branch, build, library in zip(constraints, builds, libraries, strict=True):
-                loaded = build.nlp if library is None else library
-                solver = ca.nlpsol(build.name, plugin, loaded, options)
-                solvers[branch] = BufferedFunction(solver, ("x", "f"), unbounded)
-        # casadi has loaded the libraries: their files may go (no clean-up left for the exit,
-        # which a forked helper makes with os._exit)
-        return solvers, BufferedFunction(cost_function, ("f",))
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(corner of the window in world coordinates, the values the NLP takes there: G's
@@ -509,44 +252,8 @@ class SupportMpc:
     def anchors(
         self, guess: np.ndarray, work: np.ndarray, targets: np.ndarray, blocked: np.ndarray
     ) -> np.ndarray:
-        """Where the LOS penalty pulls each blocked step.
-
-        ``paper``: the work UAV itself. ``visible-point``: the step's guess when it sees the
-        work UAV (a step held blocked by the re-solve), else the nearest point around it (26
-        directions, shells up to the horizon's reach) that sees the work UAV and has a usable
-        prior fix, the nearest to the work UAV among equals; the pre-planned waypoint when there
-        is none.
-        """
-        anchors = np.array(work, dtype=float)
-        if self.control.los_penalty == "paper" or not np.any(blocked):
-            return anchors
-        for u in np.flatnonzero(blocked):
-            anchors[u] = self._nearest_visible(guess[u], work[u], targets[u])
-        return anchors
-
-    def _nearest_visible(self, start: np.ndarray, work: np.ndarray, fallback: np.ndarray):
-        # The step itself, then shell after shell; the step and the first shell are judged in
-        # one evaluation (nine anchors in ten are found there, and a point's verdict does not
-        # depend on the points judged with it).
-        first = np.vstack([start[None], start + self._shell_radii[0] * self._directions])
-        sees = self._sees_with_a_fix(first, work)
-        if sees[0]:
-            return start
-        shells = [(first[1:], sees[1:])]
-        shells += [(start + r * self._directions, None) for r in self._shell_radii[1:]]
-        for points, verdict in shells:
-            seen = points[self._sees_with_a_fix(points, work) if verdict is None else verdict]
-            if len(seen):
-                return seen[np.argmin(np.linalg.norm(seen - work, axis=1))]
-        return fallback
-
-    def _sees_with_a_fix(self, points: np.ndarray, work: np.ndarray) -> np.ndarray:
-        """Where a point has a usable prior fix and sees the work UAV."""
-        usable = np.ones(len(points), dtype=bool)
-        if self.sigma0 is not None:
-            sigma = hermite_zero_slope(self.sigma0, self.grid, points)
-            usable = sigma <= self.control.support_max_sigma0_m
-        return usable & self.camera.observable(points, work[None])
+        """Where the LOS penalty pulls each blocked step (:mod:`ground_station.los_anchors`)."""
+        return self._anchors(guess, work, targets, blocked)
 
     def _escape_guesses(self, yhat: np.ndarray, fixed: np.ndarray, flags: np.ndarray):
         """Paths leaving at d_max per step along +-x, +-y or +-z for half the horizon, then
@@ -568,37 +275,3 @@ class SupportMpc:
         terminal_sq = float(np.sum((self._terminal_of(fixed) - path[-1]) ** 2))
         weight = self._xi_weight(terminal_sq)
         return float(self._cost(x=path.ravel(), p=np.concatenate([fixed, [weight], flags]))["f"][0])
-
-
-def support_cost_numpy(
-    path: np.ndarray,
-    yhat: np.ndarray,
-    targets: np.ndarray,
-    terminal: np.ndarray,
-    work: np.ndarray,
-    blocked: np.ndarray,
-    g_values: np.ndarray,
-    grid: VoxelGrid,
-    control: ControlSettings,
-    anchors: np.ndarray | None = None,
-) -> float:
-    """The same cost in numpy over the whole map (an independent check of the casadi model);
-    ``anchors`` default to the work UAV's path (the paper's penalty)."""
-    c = control
-    path = np.asarray(path, dtype=float).reshape(-1, 3)
-
-    def sq(a: np.ndarray) -> float:
-        return float(np.sum(np.asarray(a) ** 2))
-
-    cost = c.w_interval * sq(yhat - path[0])
-    cost += c.w_interval * sum(sq(b - a) for a, b in itertools.pairwise(path))
-    terminal_sq = sq(terminal - path[-1])
-    limit = c.d_max_support_m**2
-    cost += (c.w_interval if terminal_sq <= limit else c.w_penalty) * terminal_sq
-    cost += c.w_gnss * float(np.sum(hermite_zero_slope(g_values, grid, path)))
-    cost += c.w_waypoint * sq(path - targets)
-    anchors = work if anchors is None else anchors
-    free = ~np.asarray(blocked, dtype=bool)
-    cost += c.w_relative * float(np.sum((work - path)[free] ** 2))
-    cost += c.w_penalty * float(np.sum((anchors - path)[~free] ** 2))
-    return cost

@@ -41,12 +41,9 @@ class LocalPlanner:
         self.mpc = mpc
         self.observable = observable
 
-    def plan_all(
-        self, names: Sequence[str], request_of: Callable[[str], PlanRequest]
-    ) -> dict[str, SupportPlan]:
-        """The plans of the supports ``names``, in that order; ``request_of(name)`` builds a
-        support's problem when it is needed."""
-        return {name: self.mpc.plan(request_of(name), self.observable) for name in names}
+    def plan_all(self, requests: Sequence[PlanRequest]) -> dict[str, SupportPlan]:
+        """The plans of these problems, by support name, in their order."""
+        return {request.name: self.mpc.plan(request, self.observable) for request in requests}
 
     def close(self) -> None:
         """Nothing to release."""
@@ -63,16 +60,16 @@ class HelperPlanner(LocalPlanner):
         self.helper: MpcHelper | None = helper
         self._expected_ms: dict[str, float] = {}
 
-    def plan_all(
-        self, names: Sequence[str], request_of: Callable[[str], PlanRequest]
-    ) -> dict[str, SupportPlan]:
-        """The plans of the supports ``names``, in that order. The helper's problems are built
-        and sent first, so it starts solving while this process builds its own."""
+    def plan_all(self, requests: Sequence[PlanRequest]) -> dict[str, SupportPlan]:
+        """The plans of these problems, by support name, in their order. The helper's share is
+        sent first, so it solves while this process solves its own."""
+        by_name = {request.name: request for request in requests}
+        names = list(by_name)
         their_names, our_names = self._share(names)
-        theirs = [request_of(name) for name in their_names]
+        theirs = [by_name[name] for name in their_names]
         if theirs and not self._call(lambda h: h.send(theirs)):
-            theirs, our_names = [], list(names)
-        plans = {name: self.mpc.plan(request_of(name), self.observable) for name in our_names}
+            theirs, our_names = [], names
+        plans = {name: self.mpc.plan(by_name[name], self.observable) for name in our_names}
         if theirs:
             answer = self._call(lambda h: h.receive())
             if answer is None:

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import argparse
 import socket
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from mission.config.errors import InputError
-from mission.link.impairment import add_link_arguments, link_settings
+from mission.link.impairment import LinkSettings, add_link_arguments, link_settings
 from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.link.plan_files import read_vehicle_waypoints
 from mission.link.signing import read_signing_key
@@ -118,64 +120,100 @@ def main(argv: Sequence[str] | None = None) -> int:
     else:
         home = read_vehicle_waypoints(scenario, identity.name)[0]
     clock = ClockSettings(lockstep=args.speedup is None, speedup=args.speedup or 1.0)
+    channels = _open_channels(args, identity, port, key, link, scenario.task.supports)
+    server = VehicleServer(channels.endpoint, outs, clock, *channels.truth, args.exit_with_parent)
+    vehicle = Vehicle(
+        identity, scenario, world, home, args.seed, server.broadcast, speedup=clock.speedup
+    )
+    server.attach(vehicle)
+    install_signal_handlers(server.stop, args.exit_with_parent)
+    _print_banner(vehicle, channels, clock)
+    freeze_startup_heap()
+    try:
+        server.run()
+    finally:
+        print(server.summary(), file=sys.stderr, flush=True)
+        channels.close()
+    return 0
 
-    truth_sender = truth_receiver = None
+
+@dataclass
+class Channels:
+    """A vehicle's sockets: its MAVLink endpoint, and the truth channel's (the work UAV's
+    sender, a support's receiver)."""
+
+    endpoint: UdpEndpoint
+    truth_sender: TruthSender | None = None
+    truth_receiver: TruthReceiver | None = None
+
+    @property
+    def truth(self) -> tuple[TruthSender | None, TruthReceiver | None]:
+        """(sender, receiver) of the truth channel."""
+        return self.truth_sender, self.truth_receiver
+
+    def close(self) -> None:
+        """Close every socket."""
+        self.endpoint.close()
+        for channel in self.truth:
+            if channel is not None:
+                channel.close()
+
+
+def _open_channels(
+    args: argparse.Namespace,
+    identity: VehicleIdentity,
+    port: int,
+    key: bytes | None,
+    link: LinkSettings,
+    supports: int,
+) -> Channels:
+    """Bind (or adopt) the vehicle's sockets."""
+    truth_sender = None
     if identity.is_work:
         if args.truth_out is None:
-            supports = range(1, scenario.task.supports + 1) if port else range(0)
-            destinations = [(args.host, port + TRUTH_PORT_OFFSET + n) for n in supports]
+            others = range(1, supports + 1) if port else range(0)
+            destinations = [(args.host, port + TRUTH_PORT_OFFSET + n) for n in others]
         else:
             destinations = [_address(text, "--truth-out") for text in args.truth_out]
         truth_sender = TruthSender(identity.system_id, destinations)
     try:
-        codec = MavlinkCodec(identity.system_id, 1, key)
         endpoint = UdpEndpoint(
-            codec,
+            MavlinkCodec(identity.system_id, 1, key),
             (args.host, port),
             link,
             link_seed=args.seed * 1000 + identity.system_id,
             sock=_inherited_socket(args.socket_fd, "--socket-fd"),
         )
+        channels = Channels(endpoint, truth_sender)
         if not identity.is_work:
             truth_port = args.truth_port
             if truth_port is None:
                 truth_port = port + TRUTH_PORT_OFFSET if port else 0
             _check_port(truth_port, "--truth-port", allow_any=True)
-            truth_receiver = TruthReceiver(
+            channels.truth_receiver = TruthReceiver(
                 truth_port,
                 args.host,
                 sock=_inherited_socket(args.truth_socket_fd, "--truth-socket-fd"),
             )
     except OSError as error:
         raise InputError("command line", "--port", f"cannot listen: {error.strerror}") from None
+    return channels
 
-    server = VehicleServer(
-        endpoint, outs, clock, truth_sender, truth_receiver, args.exit_with_parent
-    )
-    vehicle = Vehicle(
-        identity, scenario, world, home, args.seed, server.broadcast, speedup=clock.speedup
-    )
-    server.attach(vehicle)
-    install_signal_handlers(server.stop, args.exit_with_parent)
+
+def _print_banner(vehicle: Vehicle, channels: Channels, clock: ClockSettings) -> None:
+    """The line that says the vehicle is up, and where it listens."""
+    identity = vehicle.identity
     pacing = "lockstep" if clock.lockstep else f"real time x{clock.speedup:g}"
-    host, bound = endpoint.address
-    truth = f", truth port {truth_receiver.endpoint.address[1]}" if truth_receiver else ""
+    host, bound = channels.endpoint.address
+    receiver = channels.truth_receiver
+    truth = f", truth port {receiver.endpoint.address[1]}" if receiver else ""
     print(
         f"vehicle {identity.name} (sysid {identity.system_id}) listening on {host}:{bound}"
-        f"{truth}, {pacing}, home {home.round(3).tolist()}, scenario {scenario.name}",
+        f"{truth}, {pacing}, home {vehicle.home.round(3).tolist()}, "
+        f"scenario {vehicle.scenario.name}",
         file=sys.stderr,
         flush=True,
     )
-    freeze_startup_heap()
-    try:
-        server.run()
-    finally:
-        print(server.summary(), file=sys.stderr, flush=True)
-        endpoint.close()
-        for channel in (truth_sender, truth_receiver):
-            if channel is not None:
-                channel.close()
-    return 0
 
 
 def _inherited_socket(fd: int | None, flag: str) -> socket.socket | None:

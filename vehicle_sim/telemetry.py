@@ -10,6 +10,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.world.camera import Observation
 from mission.world.frames import GeodeticFrame, enu_to_ned
 from mission.world.gnss import GnssFix
+from vehicle_sim import modes
 
 UINT16_UNKNOWN = 65535
 SOFTWARE_VERSION = (0 << 24) | (1 << 16) | (0 << 8) | 255  # 0.1.0, FIRMWARE_VERSION_TYPE_OFFICIAL
@@ -23,6 +24,32 @@ CAPABILITIES = (
 
 def _u16(value: float) -> int:
     return int(min(max(round(value), 0), UINT16_UNKNOWN - 1))
+
+
+def heartbeat(mode: int, armed: bool, failsafe: bool) -> mavlink2.MAVLink_heartbeat_message:
+    """A quadrotor's HEARTBEAT with ArduPilot's mode numbers, armed state and health."""
+    base = mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | mavlink2.MAV_MODE_FLAG_STABILIZE_ENABLED
+    if mode in (modes.GUIDED, modes.AUTO):
+        base |= mavlink2.MAV_MODE_FLAG_GUIDED_ENABLED
+    if mode == modes.AUTO:
+        base |= mavlink2.MAV_MODE_FLAG_AUTO_ENABLED
+    if armed:
+        base |= mavlink2.MAV_MODE_FLAG_SAFETY_ARMED
+    state = mavlink2.MAV_STATE_ACTIVE if armed else mavlink2.MAV_STATE_STANDBY
+    if failsafe:
+        state = mavlink2.MAV_STATE_CRITICAL
+    return mavlink2.MAVLink_heartbeat_message(
+        mavlink2.MAV_TYPE_QUADROTOR, mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA, base, mode, state, 3
+    )
+
+
+def sys_status(bad_packets: int) -> mavlink2.MAVLink_sys_status_message:
+    """SYS_STATUS: GPS and vision position present and healthy; errors_comm counts bad packets."""
+    sensors = mavlink2.MAV_SYS_STATUS_SENSOR_GPS | mavlink2.MAV_SYS_STATUS_SENSOR_VISION_POSITION
+    bad = min(bad_packets, 65535)
+    return mavlink2.MAVLink_sys_status_message(
+        sensors, sensors, sensors, 0, 16800, -1, -1, 0, bad, 0, 0, 0, 0, 0, 0, 0
+    )
 
 
 def gps_raw_int(

@@ -22,14 +22,11 @@ from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
 from vehicle_sim import modes, telemetry
 from vehicle_sim.commands import execute, set_mode
+from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
 
 GCS_SYSTEM_ID = 255
-POSITION_ONLY_MASK_REQUIRED = 0b0000_0001_1111_1000  # velocity + acceleration ignored
-POSITION_BITS = 0b0000_0000_0000_0111
-FORCE_BIT = 0b0000_0010_0000_0000
-MAX_ABS_COORD_M = 100_000.0
 SENSOR_STREAMS = (
     mavlink2.MAVLINK_MSG_ID_SIM_STATE,
     mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED,
@@ -112,24 +109,7 @@ class Vehicle:
 
     def heartbeat(self) -> Any:
         """The HEARTBEAT describing armed state and mode."""
-        base = mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | mavlink2.MAV_MODE_FLAG_STABILIZE_ENABLED
-        if self.mode in (modes.GUIDED, modes.AUTO):
-            base |= mavlink2.MAV_MODE_FLAG_GUIDED_ENABLED
-        if self.mode == modes.AUTO:
-            base |= mavlink2.MAV_MODE_FLAG_AUTO_ENABLED
-        if self.armed:
-            base |= mavlink2.MAV_MODE_FLAG_SAFETY_ARMED
-        state = mavlink2.MAV_STATE_ACTIVE if self.armed else mavlink2.MAV_STATE_STANDBY
-        if self.failsafe:
-            state = mavlink2.MAV_STATE_CRITICAL
-        return mavlink2.MAVLink_heartbeat_message(
-            mavlink2.MAV_TYPE_QUADROTOR,
-            mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA,
-            base,
-            self.mode,
-            state,
-            3,
-        )
+        return telemetry.heartbeat(self.mode, self.armed, self.failsafe)
 
     @property
     def time_boot_ms(self) -> int:
@@ -183,7 +163,7 @@ class Vehicle:
         if message_id == mavlink2.MAVLINK_MSG_ID_HEARTBEAT:
             return self.heartbeat()
         if message_id == mavlink2.MAVLINK_MSG_ID_SYS_STATUS:
-            return self._sys_status()
+            return telemetry.sys_status(self.counters.bad_packets)
         if message_id == mavlink2.MAVLINK_MSG_ID_MISSION_CURRENT:
             state = (
                 mavlink2.MISSION_STATE_NO_MISSION
@@ -204,15 +184,6 @@ class Vehicle:
         if work_truth is None or self.identity.is_work:
             return Observation(False, None, math.nan)
         return self.world.camera.observe(self.kinematics.truth, work_truth, self.rng_camera)
-
-    def _sys_status(self) -> Any:
-        sensors = (
-            mavlink2.MAV_SYS_STATUS_SENSOR_GPS | mavlink2.MAV_SYS_STATUS_SENSOR_VISION_POSITION
-        )
-        bad = min(self.counters.bad_packets, 65535)
-        return mavlink2.MAVLink_sys_status_message(
-            sensors, sensors, sensors, 0, 16800, -1, -1, 0, bad, 0, 0, 0, 0, 0, 0, 0
-        )
 
     # -- stepping ---------------------------------------------------------------------------
     def step(self) -> None:
@@ -296,10 +267,10 @@ class Vehicle:
             handler(self, msg)
 
     def _on_setpoint(self, msg: Any) -> None:
-        problem = self._setpoint_problem(msg)
+        problem = setpoint_problem(msg, self.armed and self.mode == modes.GUIDED)
         target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
         if problem is None:
-            problem = self._geofence_problem(target)
+            problem = geofence_problem(self.world, self.kinematics.believed, target)
             if problem is not None:  # a guided vehicle told to leave the fence stops there
                 self.kinematics.hold()
         if problem is not None:
@@ -312,38 +283,6 @@ class Vehicle:
         if self.failsafe:
             self.failsafe = False
             self.notify(mavlink2.MAV_SEVERITY_NOTICE, "Failsafe cleared: setpoints resumed")
-
-    def _setpoint_problem(self, msg: Any) -> tuple[str, str] | None:
-        """(category, detail) of what is wrong with a setpoint, or None."""
-        if msg.coordinate_frame != mavlink2.MAV_FRAME_LOCAL_NED:
-            return "frame", f"frame {msg.coordinate_frame}, LOCAL_NED only"
-        mask = int(msg.type_mask)
-        ignores_motion = (mask & POSITION_ONLY_MASK_REQUIRED) == POSITION_ONLY_MASK_REQUIRED
-        if mask & POSITION_BITS or not ignores_motion or mask & FORCE_BIT:
-            return "type_mask", f"type_mask {mask}, position targets only"
-        values = (msg.x, msg.y, msg.z)
-        if not all(math.isfinite(v) and abs(v) < MAX_ABS_COORD_M for v in values):
-            return "out of range", "position out of range"
-        if not self.armed or self.mode != modes.GUIDED:
-            return "not guided", "not armed in GUIDED"
-        return None
-
-    def _geofence_problem(self, target: np.ndarray) -> tuple[str, str] | None:
-        """Targets outside the workspace, inside the structure, or reached only through it."""
-        if not self.world.in_workspace(target[None])[0]:
-            return "geofence", "fence: outside workspace"
-        structure = self.world.structure
-        if structure is None:
-            return None
-        if structure.contains(target[None])[0]:
-            return "geofence", "fence: inside structure"
-        start = self.kinematics.believed  # the autopilot fences in its own navigation frame
-        if (
-            np.linalg.norm(target - start) > 0
-            and structure.segments_blocked(start[None], target[None])[0]
-        ):
-            return "geofence", "fence: crosses structure"
-        return None
 
     def _warn_once(self, text: str) -> None:
         """A warning STATUSTEXT, not repeated while the same problem persists (5 s)."""

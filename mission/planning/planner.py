@@ -23,7 +23,7 @@ import numpy as np
 from mission.config.errors import InputError
 from mission.link.plan_files import Plan
 from mission.world.grid import VoxelGrid
-from mission.world.model import World
+from mission.world.model import KnownWorld
 
 CANDIDATES_PER_INDEX = 1000
 
@@ -38,7 +38,7 @@ class _Candidates:
     base_cost: np.ndarray  # (K,)
 
 
-def plan_supports(world: World) -> Plan:
+def plan_supports(world: KnownWorld) -> Plan:
     """Plan every support's I waypoints for the scenario's work waypoints."""
     scenario = world.scenario
     work = np.array(scenario.task.work_waypoints_m, dtype=float)
@@ -64,7 +64,7 @@ def plan_supports(world: World) -> Plan:
     return Plan(work=work, supports=supports)
 
 
-def _check_work_waypoints(world: World, work: np.ndarray) -> None:
+def _check_work_waypoints(world: KnownWorld, work: np.ndarray) -> None:
     inside = world.structure.contains(work)
     for i in np.flatnonzero(inside):
         raise PlanningError(
@@ -74,7 +74,7 @@ def _check_work_waypoints(world: World, work: np.ndarray) -> None:
         )
 
 
-def _admissible_points(world: World) -> tuple[np.ndarray, np.ndarray]:
+def _admissible_points(world: KnownWorld) -> tuple[np.ndarray, np.ndarray]:
     """Lattice points clear of structure and ground, with a fix; and their sigma_0^2."""
     settings = world.scenario.planner
     lattice = VoxelGrid.over(world.workspace, settings.lattice_m).centers().reshape(-1, 3)
@@ -92,7 +92,7 @@ def _admissible_points(world: World) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _candidates_for(
-    world: World, admissible: tuple[np.ndarray, np.ndarray], waypoint: np.ndarray, index: int
+    world: KnownWorld, admissible: tuple[np.ndarray, np.ndarray], waypoint: np.ndarray, index: int
 ) -> _Candidates:
     points, sigma0_sq = admissible
     settings = world.scenario.planner
@@ -114,7 +114,7 @@ def _candidates_for(
 
 
 def _plan_one(
-    world: World,
+    world: KnownWorld,
     work: np.ndarray,
     candidates: list[_Candidates],
     reach: np.ndarray,
@@ -151,7 +151,7 @@ def _plan_one(
     return path
 
 
-def _legs_clear(world: World, previous: np.ndarray, current: np.ndarray) -> np.ndarray:
+def _legs_clear(world: KnownWorld, previous: np.ndarray, current: np.ndarray) -> np.ndarray:
     """(K_i, K_{i-1}) True where flying straight between the two points misses the structure."""
     starts = np.broadcast_to(previous[None, :, :], (len(current), len(previous), 3)).reshape(-1, 3)
     ends = np.broadcast_to(current[:, None, :], (len(current), len(previous), 3)).reshape(-1, 3)

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.cycle import CycleOutput, control_cycle
-from ground_station.measurements import MeasuredValues, measurements_from_values
-from ground_station.station import build_models
+from ground_station.cycle import CycleOutput, run_cycle
+from ground_station.localize import SupportReport
+from ground_station.models import build_models
 from mission.world.model import World
 from vehicle_sim.kinematics import Kinematics
 
@@ -37,7 +37,7 @@ def run_detached(
     """Run up to ``max_cycles`` control cycles (or to completion)."""
     scenario = world.scenario
     control = scenario.control
-    models, state = build_models(world, waypoints, adaptive, seed)
+    models, state = build_models(world.known(), waypoints, adaptive, seed)
     rng = np.random.default_rng([seed, 99])
     vehicles = {name: Kinematics.at(points[0]) for name, points in waypoints.items()}
     speed = {
@@ -47,18 +47,14 @@ def run_detached(
     outputs, truth = [], []
     for _ in range(max_cycles):
         work_truth = vehicles["work"].truth
-        values = []
+        reports = []
         for name in models.support_waypoints:
             y = vehicles[name].truth
             fix = world.gnss.sample_fix(y, rng, world.zone_offset(y[None])[0])
             observation = world.camera.observe(y, work_truth, rng)
-            values.append(
-                MeasuredValues(
-                    name, fix.position_m if fix.has_fix else None, observation.relative_m
-                )
-            )
-        measurements = measurements_from_values(values, world)
-        output = control_cycle(state, measurements, models)
+            position = fix.position_m if fix.has_fix else None
+            reports.append(SupportReport(name, position, observation.relative_m))
+        output = run_cycle(state, reports, models)
         outputs.append(output)
         truth.append(work_truth.copy())
         vehicles["work"].set_estimate(state.xhat)

@@ -75,53 +75,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     start = time.monotonic()
     previous = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
-        pacing = ["--speedup", str(options.speedup)] if options.speedup else []
-        if options.signing_key is not None:
-            pacing += ["--signing-key", str(options.signing_key)]
-        observer = ["--out", options.observer] if options.observer else []
-        if options.link.impaired:
-            pacing += ["--link-loss", str(options.link.loss)]
-            pacing += ["--link-delay-ms", str(options.link.delay_ms)]
-        common = [
-            "--scenario",
-            options.scenario,
-            "--seed",
-            str(options.seed),
-            *pacing,
-            "--exit-with-parent",
-        ]
-        names = vehicle_names(scenario.task.supports)
-        # Every socket is bound here and inherited, so the ground station starts first knowing
-        # every address, before any vehicle has printed its banner.
-        sockets = {name: _bound_udp() for name in names}
-        truth_sockets = {name: _bound_udp() for name in names[1:]}
-        truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
-        addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
-        helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
-        forking = options.process_start == "fork" and fork_is_safe()
-        station = ["--method", options.method, "--vehicles", addresses]
-        station += ["--out", str(options.out_dir), *helper, *common]
-        gcs = _launch(
-            options.out_dir,
-            "ground_station",
-            station,
-            (),
-            _ground_station_main if forking else None,
-        )
-        children.append(gcs)
-        vehicle_main = _vehicle_main() if forking else None
-        for name in names:
-            fds = [sockets[name].fileno()]
-            arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
-            if name in truth_sockets:
-                fds.append(truth_sockets[name].fileno())
-                arguments += ["--truth-socket-fd", str(fds[1])]
-            else:
-                arguments += truth_out
-            arguments += [*observer, *common]
-            children.append(_launch(options.out_dir, name, arguments, fds, vehicle_main))
-        for sock in (*sockets.values(), *truth_sockets.values()):
-            sock.close()  # the children hold them now
+        gcs = _start_processes(options, scenario, children)
         _supervise(gcs, children, required={"work"})
         if gcs.process.returncode != 0:
             raise RunFailed(
@@ -130,7 +84,59 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     finally:
         _stop_all(children)
         signal.signal(signal.SIGTERM, previous)
-    wall = time.monotonic() - start
+    summary = _summary(options, scenario, time.monotonic() - start)
+    write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
+    return summary
+
+
+def _common_arguments(options: RunOptions) -> list[str]:
+    """The arguments every process of the run gets."""
+    pacing = ["--speedup", str(options.speedup)] if options.speedup else []
+    if options.signing_key is not None:
+        pacing += ["--signing-key", str(options.signing_key)]
+    if options.link.impaired:
+        pacing += ["--link-loss", str(options.link.loss)]
+        pacing += ["--link-delay-ms", str(options.link.delay_ms)]
+    return ["--scenario", options.scenario, "--seed", str(options.seed), *pacing]
+
+
+def _start_processes(options: RunOptions, scenario: Scenario, children: list[Child]) -> Child:
+    """The ground station, then every vehicle, each added to ``children`` as it starts;
+    returns the ground station."""
+    common = [*_common_arguments(options), "--exit-with-parent"]
+    observer = ["--out", options.observer] if options.observer else []
+    names = vehicle_names(scenario.task.supports)
+    # Every socket is bound here and inherited, so the ground station starts first knowing
+    # every address, before any vehicle has printed its banner.
+    sockets = {name: _bound_udp() for name in names}
+    truth_sockets = {name: _bound_udp() for name in names[1:]}
+    truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
+    addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
+    helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
+    forking = options.process_start == "fork" and fork_is_safe()
+    station = ["--method", options.method, "--vehicles", addresses]
+    station += ["--out", str(options.out_dir), *helper, *common]
+    gcs_main = _ground_station_main if forking else None
+    gcs = _launch(options.out_dir, "ground_station", station, (), gcs_main)
+    children.append(gcs)
+    vehicle_main = _vehicle_main() if forking else None
+    for name in names:
+        fds = [sockets[name].fileno()]
+        arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
+        if name in truth_sockets:
+            fds.append(truth_sockets[name].fileno())
+            arguments += ["--truth-socket-fd", str(fds[1])]
+        else:
+            arguments += truth_out
+        arguments += [*observer, *common]
+        children.append(_launch(options.out_dir, name, arguments, fds, vehicle_main))
+    for sock in (*sockets.values(), *truth_sockets.values()):
+        sock.close()  # the children hold them now
+    return gcs
+
+
+def _summary(options: RunOptions, scenario: Scenario, wall: float) -> dict[str, Any]:
+    """summary.json: who ran, the tlog's metrics, wall time and the links' statistics."""
     summary = {
         "scenario": scenario.name,
         "scenario_source": scenario.source,
@@ -145,7 +151,6 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     link_file = options.out_dir / "link.json"
     if link_file.is_file():
         summary["link"] = json.loads(link_file.read_text())
-    write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
 
 

@@ -1,13 +1,17 @@
-"""The world of a scenario: structure, sky, GNSS and camera models, multipath zones.
+"""The world of a scenario, in two kinds: what anyone may know of it (:class:`KnownWorld`:
+structure, sky, GNSS and camera models, workspace) and the simulated world (:class:`World`:
+the known world and the multipath zones).
 
-Both sides build it from the same scenario, each using only what it may know: a vehicle uses
-the zones; the ground station never calls :meth:`World.zone_offset` or :meth:`World.in_zone`.
+The ground station is built from a :class:`KnownWorld`, so the zones are out of its reach by
+type, not by a promise; the vehicles and analysis take a :class:`World`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
+from typing import Self
 
 import numpy as np
 
@@ -17,7 +21,8 @@ from mission.world.camera import CameraModel
 from mission.world.gnss import GnssModel
 from mission.world.grid import VoxelGrid
 from mission.world.sky import load_sky
-from mission.world.structure import build_structure
+from mission.world.structure import Structure, build_structure
+from mission.world.zones import MultipathZones
 
 
 @dataclass(frozen=True)
@@ -31,57 +36,27 @@ class Sigma0Map:
     build_s: float
 
 
-class World:
-    """Everything physical about a scenario, built once."""
+class KnownWorld:
+    """What anyone may know of a scenario: the structure, the sky, the GNSS and camera models
+    and the workspace, and nothing of the multipath zones: its scenario has none. This is the
+    world the ground station gets."""
 
-    def __init__(self, scenario: Scenario) -> None:
-        self.scenario = scenario
-        self.structure = build_structure(scenario.world.structure, scenario.source)
+    def __init__(self, scenario: Scenario, structure: Structure | None = None) -> None:
+        """Build it for ``scenario`` (whose zones are left out); ``structure``: the scenario's
+        structure if already built."""
+        self.scenario = without_zones(scenario)
+        if structure is None:
+            structure = build_structure(scenario.world.structure, scenario.source)
+        self.structure = structure
         self.sky = load_sky(scenario.sky)
         self.gnss = GnssModel(self.sky, self.structure, scenario.gnss)
         self.camera = CameraModel(scenario.camera, self.structure)
         self.workspace = scenario.world.workspace
-        self._zone_min = np.array([z.min_m for z in scenario.world.zones]).reshape(-1, 3)
-        self._zone_max = np.array([z.max_m for z in scenario.world.zones]).reshape(-1, 3)
-        self._zone_offset = np.array([z.offset_m for z in scenario.world.zones]).reshape(-1, 3)
-        self._zone_boxes = [(z.min_m, z.max_m) for z in scenario.world.zones]
 
     @classmethod
-    def load(cls, name_or_path: str) -> World:
+    def load(cls, name_or_path: str) -> Self:
         """Load a scenario by name or path and build its world."""
         return cls(load_scenario(name_or_path))
-
-    def zone_index(self, points: np.ndarray) -> np.ndarray:
-        """Index of the first zone containing each point, -1 outside every zone (vehicle side)."""
-        points = np.atleast_2d(np.asarray(points, dtype=float))
-        if len(self._zone_min) == 0:
-            return np.full(len(points), -1)
-        if len(points) == 1:  # a vehicle's every step: plain floats beat numpy's set-up 10x
-            point = points[0].tolist()
-            for index, (low, high) in enumerate(self._zone_boxes):
-                if all(lo <= x <= hi for lo, x, hi in zip(low, point, high)):
-                    return np.array([index])
-            return np.array([-1])
-        inside = np.all(
-            (points[:, None, :] >= self._zone_min[None])
-            & (points[:, None, :] <= self._zone_max[None]),
-            axis=2,
-        )
-        return np.where(inside.any(axis=1), inside.argmax(axis=1), -1)
-
-    def in_zone(self, points: np.ndarray) -> np.ndarray:
-        """True for points inside a multipath zone (vehicle side and analysis only)."""
-        return self.zone_index(points) >= 0
-
-    def zone_offset(self, points: np.ndarray) -> np.ndarray:
-        """g_offset at each point: the containing zone's offset, zero elsewhere (vehicle side)."""
-        index = self.zone_index(points)
-        if len(index) == 1 and index[0] < 0:
-            return np.zeros((1, 3))
-        offsets = np.zeros((len(index), 3))
-        inside = index >= 0
-        offsets[inside] = self._zone_offset[index[inside]]
-        return offsets
 
     def in_workspace(self, points: np.ndarray) -> np.ndarray:
         """True for points inside the workspace box."""
@@ -109,3 +84,36 @@ class World:
             n_visible=geometry.n_visible.reshape(grid.shape),
             build_s=time.perf_counter() - start,
         )
+
+
+class World(KnownWorld):
+    """The simulated world: the known world and the multipath zones, which bias the GNSS fixes
+    taken inside them. For the vehicles and for analysis; never for the ground station."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        super().__init__(scenario)
+        self.scenario = scenario
+        self.zones = MultipathZones(scenario.world.zones)
+
+    def known(self) -> KnownWorld:
+        """This world without its zones (the same structure)."""
+        return KnownWorld(self.scenario, self.structure)
+
+    def zone_index(self, points: np.ndarray) -> np.ndarray:
+        """Index of the first zone containing each point, -1 outside every zone."""
+        return self.zones.index(points)
+
+    def in_zone(self, points: np.ndarray) -> np.ndarray:
+        """True for points inside a multipath zone."""
+        return self.zones.contains(points)
+
+    def zone_offset(self, points: np.ndarray) -> np.ndarray:
+        """g_offset at each point: the containing zone's offset, zero elsewhere."""
+        return self.zones.offset(points)
+
+
+def without_zones(scenario: Scenario) -> Scenario:
+    """The scenario with no multipath zones (everything else the same)."""
+    if not scenario.world.zones:
+        return scenario
+    return dataclasses.replace(scenario, world=dataclasses.replace(scenario.world, zones=[]))

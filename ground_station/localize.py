@@ -1,6 +1,9 @@
-"""Typed measurements from MAVLink: GPS_RAW_INT -> p_n, LANDING_TARGET -> r_n (ENU).
+"""Step 1 of the control cycle, localize: each support's GNSS fix p_n and camera observation
+r_n (ENU), with the covariances the ground station can predict for them.
 
-Only these two messages feed the estimator. SIM_STATE (truth) is logged, never read here.
+What a support reports arrives as MAVLink (GPS_RAW_INT -> p_n, LANDING_TARGET -> r_n; see
+:func:`reports_from_messages`). Only these two messages feed the estimator; SIM_STATE (the
+truth) is logged, never read.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ import numpy as np
 
 from ground_station.fusion import SupportMeasurement
 from mission.world.frames import GeodeticFrame, ned_to_enu
-from mission.world.model import World
+from mission.world.model import KnownWorld
 
 MIN_3D_FIX = 3
 
@@ -34,26 +37,10 @@ def relative_observation(message: Any | None) -> np.ndarray | None:
     return r if np.all(np.isfinite(r)) and np.linalg.norm(r) > 0 else None
 
 
-def support_measurements(
-    messages: Sequence[tuple[str, Any | None, Any | None]], world: World, frame: GeodeticFrame
-) -> list[SupportMeasurement]:
-    """p_n, r_n and their covariances from each support's (name, GPS_RAW_INT, LANDING_TARGET)
-    of the step."""
-    values = []
-    for name, gps, target in messages:
-        fix = gnss_fix(gps, frame)
-        reported = None
-        if fix is not None:
-            h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
-            reported = np.diag([h * h / 2, h * h / 2, v * v])
-        values.append(MeasuredValues(name, fix, relative_observation(target), reported))
-    return measurements_from_values(values, world)
-
-
 @dataclass(frozen=True)
-class MeasuredValues:
-    """One support's measured p_n and r_n (None where missing) and the receiver's reported
-    covariance."""
+class SupportReport:
+    """What one support reported this cycle: p_n and r_n (ENU; None where missing) and the
+    receiver's own accuracy as a covariance."""
 
     name: str
     fix: np.ndarray | None
@@ -61,12 +48,25 @@ class MeasuredValues:
     reported: np.ndarray | None = None
 
 
-def measurements_from_values(
-    values: Sequence[MeasuredValues], world: World
-) -> list[SupportMeasurement]:
-    """Covariances evaluated at the measured values (MODEL.md 3.2.1): the GNSS geometry of
-    every fix in one batch and the camera's Sigma_r of every observation in another (the same
-    numbers as one at a time, tested).
+def reports_from_messages(
+    messages: Sequence[tuple[str, Any | None, Any | None]], frame: GeodeticFrame
+) -> list[SupportReport]:
+    """Each support's report from its (name, GPS_RAW_INT, LANDING_TARGET) of the step."""
+    reports = []
+    for name, gps, target in messages:
+        fix = gnss_fix(gps, frame)
+        reported = None
+        if fix is not None:
+            h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
+            reported = np.diag([h * h / 2, h * h / 2, v * v])
+        reports.append(SupportReport(name, fix, relative_observation(target), reported))
+    return reports
+
+
+def localize(values: Sequence[SupportReport], world: KnownWorld) -> list[SupportMeasurement]:
+    """p_n and r_n with covariances evaluated at the measured values (MODEL.md 3.2.1): the GNSS
+    geometry of every fix in one batch and the camera's Sigma_r of every observation in
+    another (the same numbers as one at a time, tested).
 
     Where the model sees no fix at p_n but the receiver has one, the receiver's reported
     accuracy stands in for Sigma_GNSS.

@@ -1,0 +1,138 @@
+"""The support MPC's NLPs compiled to shared libraries with the system C compiler, and cached.
+
+casadi generates C for the functions a solver evaluates (cost, constraints and their
+derivatives); compiled, a solve is ~1.5x faster than with casadi's interpreter. The first run
+generates and compiles (both NLPs at once, one compiler process each); later runs load the
+cached libraries and build nothing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import casadi as ca
+
+# -O1: as fast a solve as -O2 (1,220 recorded solves, bit-identical results) and the
+# generated ~1.2 MB of C compiles in 5.8 s instead of 8.6 s
+COMPILE_FLAGS = ["-O1", "-fPIC", "-shared"]
+
+
+@dataclass(frozen=True)
+class NlpBuild:
+    """One NLP to compile: the solver's name and casadi plugin, the NLP (keys x, p, f, g) and
+    the solver's options."""
+
+    name: str
+    plugin: str
+    nlp: dict[str, ca.MX]
+    options: dict
+
+
+def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> list[str | None]:
+    """For each build, the functions its casadi solver needs, compiled into a shared library
+    with the system C compiler (about 1.5x faster solves than interpreting them), or None
+    without one. The libraries not yet cached are compiled at the same time, one compiler
+    process each.
+
+    A library is cached (under ``$XDG_CACHE_HOME`` or ``~/.cache``) by the hash of the
+    serialised NLP, the solver's name, plugin and options, the casadi version, the compiler
+    and its flags: a run after the first builds no solver from the expressions, generates no
+    C and compiles nothing. The C sources are generated in a scratch directory that is gone on
+    return; where the cache cannot be written, the libraries go to ``fallback_dir()``.
+    """
+    compiler = shutil.which("gcc") or shutil.which("cc")
+    libraries: list[str | None] = [None] * len(builds)
+    if compiler is None:
+        return libraries
+    missing: dict[int, str] = {}
+    for index, build in enumerate(builds):
+        library_name = _library_name(compiler, build)
+        cached = _cache_dir() / library_name
+        if cached.is_file():
+            libraries[index] = str(cached)
+        else:
+            missing[index] = library_name
+    if not missing:
+        return libraries
+    with tempfile.TemporaryDirectory(prefix="support-mpc-c-") as scratch:
+        sources: dict[int, tuple[str, Path]] = {}
+        for index, library_name in missing.items():
+            build = builds[index]
+            solver = ca.nlpsol(build.name, build.plugin, build.nlp, build.options)
+            source = f"support_mpc_nlp{index}.c"  # its stem must be a C identifier
+            with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
+                solver.generate_dependencies(source)
+            sources[index] = (library_name, Path(scratch) / source)
+        for directory_of in (_cache_dir, lambda: Path(fallback_dir())):
+            if not sources:
+                break
+            try:
+                directory = directory_of()
+                directory.mkdir(parents=True, exist_ok=True)
+            except OSError:
+                continue
+            for index, library in _compile_all(compiler, sources, directory).items():
+                libraries[index] = library
+                del sources[index]
+    return libraries
+
+
+def _library_name(compiler: str, build: NlpBuild) -> str:
+    nlp = build.nlp
+    functions = ca.Function("nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
+    recipe = "\n".join(
+        [
+            f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}",
+            build.name,
+            build.plugin,
+            repr(sorted(build.options.items())),
+            functions.serialize(),
+        ]
+    )
+    return f"support_mpc_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
+
+
+def _compile_all(
+    compiler: str, sources: dict[int, tuple[str, Path]], directory: Path
+) -> dict[int, str]:
+    """Compile every source into ``directory`` at once; the libraries that were made, by
+    index. A library appears under its name only when complete."""
+    running: dict[int, tuple[subprocess.Popen, Path, Path]] = {}
+    made: dict[int, str] = {}
+    try:
+        for index, (library_name, source) in sources.items():
+            partial = directory / f".{library_name}.{os.getpid()}.part"
+            command = [compiler, *COMPILE_FLAGS, str(source), "-o", str(partial)]
+            with contextlib.suppress(OSError):
+                process = subprocess.Popen(
+                    command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+                )
+                running[index] = (process, partial, directory / library_name)
+        for index, (process, partial, library) in running.items():
+            try:
+                if process.wait() == 0:
+                    os.replace(partial, library)
+                    made[index] = str(library)
+            except OSError:
+                pass
+            finally:
+                partial.unlink(missing_ok=True)
+    finally:
+        for process, _, _ in running.values():  # interrupted: no compiler outlives us
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+    return made
+
+
+def _cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "bridge-uav-formation"

@@ -1,0 +1,79 @@
+"""Step 5 of the control cycle, plan: the work UAV's path by Algorithm 1 and each support's
+MPC problem around it (:func:`plan`); then the supports' MPCs solved (:func:`solve_supports`).
+
+The two are apart so the work UAV's command, which does not depend on the supports' plans, can
+leave before they are solved.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ground_station.localizability import hermite_zero_slope
+from ground_station.models import Models
+from ground_station.state import StationState, reachable
+from ground_station.support_mpc import PlanRequest, SupportPlan
+from ground_station.work_mpc import WorkPrediction, predict_work
+
+ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape starts too
+
+
+@dataclass(frozen=True)
+class FormationPlan:
+    """The work UAV's predicted path and each support's MPC problem, posed but not solved."""
+
+    work: WorkPrediction
+    requests: list[PlanRequest]
+
+
+def plan(state: StationState, models: Models, supports: Sequence[str]) -> FormationPlan:
+    """The work UAV's path from xhat (its command is the first point) and the MPC problem of
+    each of ``supports``; records the work UAV's commanded displacement in ``state``."""
+    control = models.scenario.control
+    work = predict_work(
+        state.xhat,
+        state.k,
+        models.work_waypoints,
+        control.horizon_steps,
+        control.d_max_work_m,
+        control.arrival_tol_m,
+    )
+    reach = control.s_max_work_m_s * control.t_cont_s
+    state.last_work_command = reachable(state.xhat, work.command, reach)
+    return FormationPlan(work, [support_request(state, name, work, models) for name in supports])
+
+
+def solve_supports(
+    state: StationState, formation: FormationPlan, models: Models
+) -> dict[str, SupportPlan]:
+    """Every support's MPC solved (here, or shared with the helper process); each plan's
+    commanded displacement and path (the next warm start) go into ``state``."""
+    plans = models.planner.plan_all(formation.requests)
+    control = models.scenario.control
+    reach = control.s_max_support_m_s * control.t_cont_s
+    for name, support_plan in plans.items():
+        state.last_support_command[name] = reachable(state.yhat[name], support_plan.command, reach)
+        state.warm[name] = support_plan.path
+    return plans
+
+
+def support_request(
+    state: StationState, name: str, work: WorkPrediction, models: Models
+) -> PlanRequest:
+    """One support's MPC problem; with escape starts where G says GNSS is worse than the prior
+    map expected."""
+    yhat = state.yhat[name]
+    g = models.g
+    initial = float(hermite_zero_slope(g.initial, g.grid, yhat)[0])
+    escape = bool(g.smoothed(yhat)[0] > initial + ESCAPE_MARGIN_M)
+    return models.support_mpc.request(
+        name,
+        yhat,
+        models.support_waypoints[name],
+        work.path,
+        work.indices,
+        g.values,
+        state.warm.get(name),
+        escape=escape,
+    )

@@ -1,0 +1,68 @@
+"""What a ground station writes besides its tlog: ``records.jsonl`` (one line per control
+cycle), ``g/G_*.npy`` (snapshots of the map G) and ``link.json`` (what the links lost and how
+the lockstep recovered)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ground_station.cycle import CycleOutput
+from ground_station.localizability import LocalizabilityMap
+from ground_station.state import StationState
+from mission.procs.atomic import write_text_atomically
+
+SNAPSHOT_EVERY = 20  # cycles between snapshots of G
+
+
+class RunRecords:
+    """The per-cycle record and G's snapshots, written as the run goes (flushed each cycle)."""
+
+    def __init__(self, out_dir: Path) -> None:
+        self.out_dir = out_dir
+        self._records = (out_dir / "records.jsonl").open("w", encoding="utf-8")
+        self._snapshots = out_dir / "g"
+        self._snapshots.mkdir(exist_ok=True)
+
+    def cycle(self, state: StationState, output: CycleOutput, time_s: float) -> None:
+        """One line: the estimates, S, beta_n, arrival, G's update and each MPC's solve."""
+        fusion = output.fusion
+        record = {
+            "t": round(time_s, 3),
+            "k": state.k,
+            "xhat": _rounded(state.xhat),
+            "blind": fusion.blind,
+            "fallback": fusion.fallback,
+            "consistent": list(fusion.consistent),
+            "contributing": list(fusion.contributing),
+            "yhat": {n: _rounded(y) for n, y in state.yhat.items()},
+            "beta": output.betas,
+            "arrived": output.arrived,
+            "g_updated_voxels": output.updated_voxels,
+            "mpc": {
+                n: {"status": p.status, "ms": round(p.solve_ms, 3), "resolved": p.resolved}
+                for n, p in output.support_plans.items()
+            },
+            "cycle_ms": round(output.cycle_ms, 3),
+        }
+        self._records.write(json.dumps(record) + "\n")
+        self._records.flush()
+
+    def snapshot(self, g: LocalizabilityMap, label: str) -> None:
+        """G's values as ``g/G_<label>.npy``."""
+        np.save(self._snapshots / f"G_{label}.npy", g.values)
+
+    def link_stats(self, stats: dict[str, Any]) -> None:
+        """``link.json``."""
+        write_text_atomically(self.out_dir / "link.json", json.dumps(stats) + "\n")
+
+    def close(self) -> None:
+        """Close the records file."""
+        self._records.close()
+
+
+def _rounded(v: np.ndarray) -> list[float]:
+    return [round(float(x), 4) for x in v]

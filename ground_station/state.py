@@ -1,0 +1,34 @@
+"""What the ground station carries from one control cycle to the next."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class StationState:
+    """The estimates (xhat of the work UAV, yhat_n of each support), the current work waypoint
+    k, the displacement each vehicle was last commanded, and each support MPC's last path (its
+    next warm start)."""
+
+    xhat: np.ndarray
+    yhat: dict[str, np.ndarray]
+    k: int
+    last_work_command: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    last_support_command: dict[str, np.ndarray] = field(default_factory=dict)
+    warm: dict[str, np.ndarray] = field(default_factory=dict)
+    completed: bool = False
+
+    def forget(self, support: str) -> None:
+        """Drop what was carried for a support that fell silent and is back."""
+        self.warm.pop(support, None)
+        self.last_support_command.pop(support, None)
+
+
+def reachable(start: np.ndarray, target: np.ndarray, reach: float) -> np.ndarray:
+    """The displacement a vehicle makes toward ``target`` in one cycle, at most ``reach``."""
+    move = target - start
+    distance = float(np.linalg.norm(move))
+    return move if distance <= reach else move * (reach / distance)

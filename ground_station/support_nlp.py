@@ -1,0 +1,189 @@
+"""The support MPC's NLP (paper 4.2.2) as casadi expressions, and its solvers.
+
+Decision variables: the U predicted positions V'_n. Cost, exactly the paper's four terms:
+
+  C_GNSS     = sum_u w_GNSS G_s(v_u)
+  C_interval = xi(|yhat - v_1|) + sum_u xi(|v_{u+1} - v_u|) + xi(|w_{n,k_{U+1}} - v_U|),
+               xi(d) = w_interval d^2 if d <= d_max else w_penalty d^2
+  C_waypoint = sum_u w_waypoint |v_u - w_{n,k_u}|^2
+  C_relative = sum_u (w_relative, or w_penalty if not observable) |v^(w)_u - v_u|^2
+
+Each step is also bounded hard by d_max (the vehicle cannot fly faster), where xi is exactly
+w_interval d^2; the terminal link keeps the jump at d_max, which the solver sees as two smooth
+NLPs, *near* (|w - v_U| <= d_max, weight w_interval) and *far* (weight w_penalty): see
+:mod:`ground_station.support_mpc`. G_s enters as the explicit eight-corner sum of
+:func:`~ground_station.localizability.casadi_hermite` over a window of voxels around yhat_n,
+so the solver gets exact second derivatives.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import tempfile
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ground_station.casadi_buffer import BufferedFunction
+from ground_station.localizability import inlined_hermite
+from ground_station.nlp_cache import NlpBuild, compiled_nlps
+from mission.config.settings import ControlSettings
+from mission.world.grid import VoxelGrid
+
+IPOPT_OPTIONS = {
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "print_time": False,
+    "calc_lam_p": False,  # unused; its gradient over the G window costs more than the solve
+    "ipopt.max_iter": 50,
+    "ipopt.tol": 1e-4,  # positions to ~0.1 mm; 1e-6 cost 25 % more iterations for nothing
+    "ipopt.acceptable_tol": 1e-4,
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.hessian_approximation": "exact",  # measured: 3x fewer ms than L-BFGS here
+    # MUMPS's matching-based permutation and scaling are for hard large systems; here they
+    # cost 5 % of a solve and change the solutions by 1e-14 (600 recorded problems)
+    "ipopt.mumps_permuting_scaling": 0,
+}
+# fatrop runs IPOPT's algorithm (filter line search, same barrier defaults) without IPOPT's
+# per-solve set-up of its objects and of MUMPS, which is ~90 % of a 15-variable solve: 3x
+# fewer ms. One dense stage ("none") is all 15 variables need.
+FATROP_OPTIONS = {
+    "structure_detection": "none",
+    "print_time": False,
+    "calc_lam_p": False,
+    # bound_push as IPOPT's warm start has it: the guess is the previous plan, shifted
+    "fatrop": {"print_level": 0, "tol": 1e-4, "max_iter": 50, "bound_push": 1e-3},
+}
+SOLVER_OPTIONS = {"fatrop": FATROP_OPTIONS, "ipopt": IPOPT_OPTIONS}
+
+
+@dataclass(frozen=True)
+class NlpSymbols:
+    """The decision variables and the parameters of the support MPC's NLP."""
+
+    v: ca.MX  # (3, U) the predicted positions
+    yhat: ca.MX
+    targets: ca.MX  # (3, U) w_{n,k_u}
+    terminal: ca.MX  # w_{n,k_{U+1}}
+    work: ca.MX  # (3, U) the work UAV's predicted path
+    anchors: ca.MX  # (3, U) where a blocked step is pulled (see ground_station.los_anchors)
+    blocked: ca.MX  # (U,) 1 where the step is not observable
+    values: ca.MX  # G over the window
+    prior: ca.MX  # sigma_0 over the window (empty without the shadow constraint)
+    corner: ca.MX  # the window's corner, world coordinates
+    terminal_weight: ca.MX  # xi's weight on the branch being solved
+
+    @classmethod
+    def make(cls, horizon: int, n_window: int, with_prior: bool) -> NlpSymbols:
+        """Fresh symbols for a horizon of U steps and a window of ``n_window`` voxels."""
+        sym = ca.MX.sym
+        return cls(
+            v=sym("v", 3, horizon),
+            yhat=sym("yhat", 3),
+            targets=sym("w", 3, horizon),
+            terminal=sym("terminal", 3),
+            work=sym("vw", 3, horizon),
+            anchors=sym("q", 3, horizon),
+            blocked=sym("blocked", horizon),
+            values=sym("G", n_window),
+            prior=sym("sigma0", n_window if with_prior else 0),
+            corner=sym("corner", 3),
+            terminal_weight=sym("w_terminal"),
+        )
+
+    def parameters(self) -> ca.MX:
+        """Every parameter in the order the solver takes them (the window's values last)."""
+        return ca.vertcat(
+            self.yhat,
+            ca.vec(self.targets),
+            self.terminal,
+            ca.vec(self.work),
+            self.terminal_weight,
+            ca.vec(self.anchors),
+            self.blocked,
+            self.corner,
+            self.values,
+            self.prior,
+        )
+
+
+@dataclass(frozen=True)
+class SupportNlp:
+    """The solvers of the near and far branches and the cost as a function of (x, p)."""
+
+    solvers: dict[str, BufferedFunction]
+    cost: BufferedFunction
+
+
+def build_support_nlp(control: ControlSettings, window: VoxelGrid, with_prior: bool) -> SupportNlp:
+    """The NLP over a window of voxels, its functions compiled when a C compiler is there."""
+    horizon = control.horizon_steps
+    s = NlpSymbols.make(horizon, window.n_voxels, with_prior)
+    hermite = inlined_hermite(window)  # G_s and the prior's, per step
+    cost = _cost(control, s, hermite)
+    terminal_sq = ca.sumsqr(s.terminal - s.v[:, horizon - 1])
+    cost += s.terminal_weight * terminal_sq
+    parameters = s.parameters()
+    # The vehicle cannot fly faster than s_max: each predicted step is also bounded hard
+    # (the paper's penalty alone lets a discontinuous cost trap the solver beyond d_max).
+    steps = [ca.sumsqr(s.v[:, 0] - s.yhat)]
+    steps += [ca.sumsqr(s.v[:, u + 1] - s.v[:, u]) for u in range(horizon - 1)]
+    # Stay where the prior map (structure and sky, no zones) predicts a usable fix: the
+    # paper's LOS penalty pulls a blocked support straight at the work UAV, i.e. under the
+    # deck, where it would lose its fix (and fly into the structure).
+    shadow = [hermite(s.v[:, u] - s.corner, s.prior) for u in range(horizon)] if with_prior else []
+    cost_function = ca.Function(
+        "support_mpc_cost", [ca.vec(s.v), parameters], [cost], ["x", "p"], ["f"]
+    )
+    # With an infinite bound on far's terminal row fatrop failed 99 of 1,220 recorded solves
+    # and carried the failure into the solves after it (plans then depended on the order of
+    # solving); without the row it solves them all, as IPOPT does. No bound of either branch
+    # is infinite.
+    constraints = {
+        "near": ca.vertcat(*steps, terminal_sq, *shadow),
+        "far": ca.vertcat(*steps, *shadow),
+    }
+    nlps = {
+        b: {"x": ca.vec(s.v), "p": parameters, "f": cost, "g": g} for b, g in constraints.items()
+    }
+    return SupportNlp(_solvers(control.mpc_solver, nlps), BufferedFunction(cost_function, ("f",)))
+
+
+def _cost(control: ControlSettings, s: NlpSymbols, hermite: ca.Function) -> ca.MX:
+    """The paper's cost but the terminal link (solved per branch). Steps are bounded hard,
+    where xi(d) = w_interval d^2 exactly: writing it so keeps the cost smooth."""
+    c, v = control, s.v
+    horizon = control.horizon_steps
+    cost = c.w_interval * ca.sumsqr(s.yhat - v[:, 0])
+    for u in range(horizon):
+        cost += c.w_gnss * hermite(v[:, u] - s.corner, s.values)
+        cost += c.w_waypoint * ca.sumsqr(v[:, u] - s.targets[:, u])
+        cost += (1 - s.blocked[u]) * c.w_relative * ca.sumsqr(s.work[:, u] - v[:, u])
+        cost += s.blocked[u] * c.w_penalty * ca.sumsqr(s.anchors[:, u] - v[:, u])
+        if u + 1 < horizon:
+            cost += c.w_interval * ca.sumsqr(v[:, u + 1] - v[:, u])
+    return cost
+
+
+def _solvers(plugin: str, nlps: dict[str, dict[str, ca.MX]]) -> dict[str, BufferedFunction]:
+    """One solver per branch, from compiled libraries where a C compiler is there."""
+    options = SOLVER_OPTIONS[plugin]
+    unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
+    builds = [
+        NlpBuild(f"support_mpc_{branch}", plugin, nlp, options) for branch, nlp in nlps.items()
+    ]
+    solvers = {}
+    with contextlib.ExitStack() as scratch:  # for libraries the cache cannot take
+
+        def private_directory() -> str:
+            return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
+
+        libraries = compiled_nlps(builds, private_directory)
+        for branch, build, library in zip(nlps, builds, libraries, strict=True):
+            loaded = build.nlp if library is None else library
+            solver = ca.nlpsol(build.name, plugin, loaded, options)
+            solvers[branch] = BufferedFunction(solver, ("x", "f"), unbounded)
+    # casadi has loaded the libraries: their files may go (no clean-up left for the exit,
+    # which a forked helper makes with os._exit)
+    return solvers
