@@ -48,7 +48,7 @@ def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> li
     C and compiles nothing. The C sources are generated in a scratch directory that is gone on
     return; where the cache cannot be written, the libraries go to ``fallback_dir()``.
     """
-    compiler = shutil.which("gcc") or shutil.which("cc")
+    compiler = c_compiler()
     libraries: list[str | None] = [None] * len(builds)
     if compiler is None:
         return libraries
@@ -83,6 +83,11 @@ def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> li
                 libraries[index] = library
                 del sources[index]
     return libraries
+
+
+def c_compiler() -> str | None:
+    """The system C compiler casadi's generated code is compiled with (None: interpreted)."""
+    return shutil.which("gcc") or shutil.which("cc")
 
 
 def _library_name(compiler: str, build: NlpBuild) -> str:

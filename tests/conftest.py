@@ -1,7 +1,15 @@
-"""Shared fixtures: scenarios and worlds are built once per test session."""
+"""Shared fixtures (scenarios and worlds built once per session) and the fast lane's guard.
+
+Every test that starts a process of the project (a vehicle, a ground station, a run, a forked
+child, a Python interpreter) is marked ``slow``; ``pytest -m "not slow"`` runs the rest. The
+guard below fails an unmarked test that starts one, so the fast lane stays fast.
+"""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import textwrap
 from collections.abc import Callable
 from pathlib import Path
@@ -35,3 +43,43 @@ def write_scenario(tmp_path: Path) -> Callable[[str, str], Path]:
         return path
 
     return write
+
+
+def _is_python(program: object) -> bool:
+    name = os.path.basename(str(program))
+    return str(program) == sys.executable or name.startswith("python")
+
+
+GUARD = pytest.StashKey[pytest.MonkeyPatch]()
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_setup(item: pytest.Item):
+    """From a fast test's set-up (its fixtures included) to its teardown, forking or starting
+    a Python interpreter fails the test: a test that starts processes is marked ``slow``."""
+    if item.get_closest_marker("slow") is None:
+        guard = pytest.MonkeyPatch()
+        popen_init = subprocess.Popen.__init__
+
+        def guarded_init(self, args, *more, **options):
+            program = args[0] if isinstance(args, list | tuple) else str(args).split()[0]
+            if _is_python(program):
+                raise AssertionError(f"{item.nodeid} starts {program}: mark it slow")
+            popen_init(self, args, *more, **options)
+
+        def guarded_fork():
+            raise AssertionError(f"{item.nodeid} forks: mark it slow")
+
+        guard.setattr(subprocess.Popen, "__init__", guarded_init)
+        guard.setattr(os, "fork", guarded_fork)
+        item.stash[GUARD] = guard
+    yield
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_teardown(item: pytest.Item):
+    """The guard lifted once the test's own teardown has run."""
+    yield
+    guard = item.stash.get(GUARD, None)
+    if guard is not None:
+        guard.undo()

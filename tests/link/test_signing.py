@@ -33,6 +33,7 @@ def _mission_count(client: MavClient) -> object:
     return client.wait_for("MISSION_REQUEST_INT", 1.5)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("client_key", "obeyed"),
     [(KEY, True), (None, False), (WRONG, False)],
@@ -64,6 +65,7 @@ def test_a_signed_vehicle_obeys_only_signed_traffic(key_file, along, client_key,
         assert count >= 5, log
 
 
+@pytest.mark.slow
 def test_signed_telemetry_carries_a_signature(key_file):
     with vehicle_process("support-1", "--signing-key", str(key_file)) as vehicle:
         client = MavClient(vehicle.address, signing_key=KEY)
@@ -72,6 +74,7 @@ def test_signed_telemetry_carries_a_signature(key_file):
     assert messages and all(m.get_signed() for m in messages)
 
 
+@pytest.mark.slow
 def test_a_repeated_tick_gets_the_step_again_signed_afresh(key_file):
     """A lost step is asked for again with the same tick; identical bytes would be replays,
     which signing refuses, so the vehicle signs the step's telemetry again."""

@@ -50,6 +50,7 @@ def test_shipped_plan_satisfies_the_planner_constraints(along_world, shipped):
         assert min(gaps) >= scenario.planner.min_separation_m - ROUNDING_M
 
 
+@pytest.mark.slow
 def test_replanning_reproduces_the_shipped_files_byte_for_byte(tmp_path, along):
     plot = tmp_path / "plan.png"
     result = subprocess.run(

@@ -17,6 +17,8 @@ import pytest
 
 from tests.processes import ROOT, vehicle_pids
 
+pytestmark = pytest.mark.slow  # every test here starts processes
+
 SHORT = """
 extends: along
 name: short-run

@@ -13,6 +13,8 @@ from mission.world.frames import GeodeticFrame, ned_to_enu
 from tests.mav_client import MavClient, last, truth_of
 from tests.processes import vehicle_process
 
+pytestmark = pytest.mark.slow  # every test here starts processes
+
 STEP_MS = 500
 QUANTUM_M = 0.012  # 1e-7 degree of latitude is 1.1 cm: SIM_STATE's resolution
 

@@ -103,6 +103,7 @@ def test_an_unfinished_or_foreign_run_directory_does_not_count(tmp_path):
     assert finished_summary(tmp_path, trial) is None
 
 
+@pytest.mark.slow
 def test_rerunning_an_unfinished_run_starts_from_an_empty_directory(tmp_path):
     """What an interrupted run left (a partial tlog, no summary) is wiped before it reruns."""
     from mission.runs.batch import _start_run
@@ -139,6 +140,7 @@ def _batch(out: Path) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 def test_a_three_seed_paired_along_batch_ac_beats_nac_on_every_seed(tmp_path):
     result = _batch(tmp_path)
     assert result.returncode == 0, result.stderr
@@ -155,6 +157,7 @@ def test_a_three_seed_paired_along_batch_ac_beats_nac_on_every_seed(tmp_path):
     assert (tmp_path / "results.csv").read_bytes() == before
 
 
+@pytest.mark.slow
 def test_a_terminated_batch_leaves_no_process_behind(tmp_path):
     out = tmp_path / "stopped"
     batch = subprocess.Popen(

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -63,6 +62,7 @@ def _same(a: SupportPlan, b: SupportPlan) -> bool:
     )
 
 
+@pytest.mark.slow
 def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along_world, local):
     helper = MpcHelper()
     helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
@@ -70,8 +70,8 @@ def test_the_helper_makes_the_same_plans_bit_for_bit_and_stops_when_closed(along
     try:
         for index in (2, 6, 9):
             requests = _requests(along_world, local.mpc, index)
-            expected = local.plan_all(*_lazily(requests))
-            got = shared.plan_all(*_lazily(requests))
+            expected = local.plan_all(requests)
+            got = shared.plan_all(requests)
             assert list(got) == [r.name for r in requests]
             assert all(_same(got[name], expected[name]) for name in expected)
         assert shared.helper is not None  # it was used throughout, not dropped
@@ -103,9 +103,9 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
     IPOPT's algorithm, and the interpreter evaluates the same functions."""
     from dataclasses import replace as replaced
 
-    from ground_station import support_mpc
+    from ground_station import support_nlp
 
-    monkeypatch.setattr(support_mpc, "compiled_nlps", lambda builds, _: [None] * len(builds))
+    monkeypatch.setattr(support_nlp, "compiled_nlps", lambda builds, _: [None] * len(builds))
     control = replaced(along_world.scenario.control, mpc_solver=solver)
     interpreted = SupportMpc(
         control, along_world.map_grid(), along_world.camera, along_world.sigma0_map().sigma_m
@@ -118,13 +118,14 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
         np.testing.assert_allclose(theirs.path, ours.path, atol=1e-3 if solver == "ipopt" else 1e-6)
 
 
+@pytest.mark.slow
 def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, monkeypatch):
     def threads_after_a_plan() -> int:
         helper = MpcHelper(fork=False)  # a fresh interpreter: its BLAS reads the environment
         helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
         shared = HelperPlanner(local.mpc, local.observable, helper)
         try:
-            shared.plan_all(*_lazily(_requests(along_world, local.mpc, 2)))  # numpy, casadi in
+            shared.plan_all(_requests(along_world, local.mpc, 2))  # numpy, casadi in
             return len(os.listdir(f"/proc/{helper.process.pid}/task"))
         finally:
             shared.close()
@@ -138,6 +139,7 @@ def test_the_helper_asks_blas_for_one_thread_unless_told(along_world, local, mon
         assert threads_after_a_plan() > unset  # numpy's and casadi's OpenBLAS add workers
 
 
+@pytest.mark.slow
 def test_setting_up_a_dead_helper_fails_with_an_os_error(along_world):
     helper = MpcHelper()
     helper.process.kill()
@@ -147,20 +149,21 @@ def test_setting_up_a_dead_helper_fails_with_an_os_error(along_world):
     helper.close()
 
 
+@pytest.mark.slow
 def test_a_dead_helpers_share_is_solved_here(along_world, local, capfd):
     helper = MpcHelper()
     helper.set_up(along_world.scenario, along_world.sigma0_map().sigma_m)
     shared = HelperPlanner(local.mpc, local.observable, helper)
     requests = _requests(along_world, local.mpc, 4)
-    shared.plan_all(*_lazily(requests))  # the helper answered once
+    shared.plan_all(requests)  # the helper answered once
     helper.process.kill()
     helper.process.wait()
-    got = shared.plan_all(*_lazily(requests))
-    expected = local.plan_all(*_lazily(requests))
+    got = shared.plan_all(requests)
+    expected = local.plan_all(requests)
     assert all(_same(got[name], expected[name]) for name in expected)
     assert shared.helper is None
     assert "MPC helper stopped" in capfd.readouterr().err
-    shared.plan_all(*_lazily(requests))  # and it goes on without one
+    shared.plan_all(requests)  # and it goes on without one
     shared.close()
 
 
@@ -181,8 +184,8 @@ def test_the_longest_expected_solve_goes_to_the_helper_the_rest_balance(local):
     assert share("a", "b") == ([], ["a", "b"])
 
 
-def test_the_helpers_problems_are_sent_before_this_process_builds_its_own(along_world, local):
-    requests = {r.name: r for r in _requests(along_world, local.mpc, 6)}
+def test_the_helpers_share_is_sent_before_this_process_solves_its_own(along_world, local):
+    requests = _requests(along_world, local.mpc, 6)
     events: list[str] = []
 
     class RecordingHelper:  # answers with the plans this process would make
@@ -194,27 +197,15 @@ def test_the_helpers_problems_are_sent_before_this_process_builds_its_own(along_
             events.append("receive")
             return self.answer
 
-    shared = HelperPlanner(local.mpc, local.observable, helper=RecordingHelper())  # type: ignore[arg-type]
+    class RecordingMpc:  # this process's solves, recorded
+        def plan(self, request, observable):
+            events.append("solve " + request.name)
+            return local.mpc.plan(request, observable)
+
+    shared = HelperPlanner(RecordingMpc(), local.observable, helper=RecordingHelper())  # type: ignore[arg-type]
     shared._expected_ms = {"support-1": 1.0, "support-2": 9.0, "support-3": 2.0}
-
-    def request_of(name: str) -> PlanRequest:
-        events.append("build " + name)
-        return requests[name]
-
-    plans = shared.plan_all(list(requests), request_of)
-    assert events == [
-        "build support-2",
-        "send support-2",
-        "build support-3",
-        "build support-1",
-        "receive",
-    ]
+    plans = shared.plan_all(requests)
+    assert events == ["send support-2", "solve support-3", "solve support-1", "receive"]
     assert list(plans) == ["support-1", "support-2", "support-3"]  # in the order asked
-    expected = local.plan_all(*_lazily(list(requests.values())))
+    expected = local.plan_all(requests)
     assert all(_same(plans[name], expected[name]) for name in expected)
-
-
-def _lazily(requests: list[PlanRequest]) -> tuple[list[str], Callable[[str], PlanRequest]]:
-    """plan_all's arguments for ready-made requests."""
-    by_name = {r.name: r for r in requests}
-    return list(by_name), by_name.__getitem__

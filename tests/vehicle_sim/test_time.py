@@ -9,6 +9,8 @@ import pytest
 from tests.mav_client import MavClient
 from tests.processes import vehicle_process
 
+pytestmark = pytest.mark.slow  # every test here starts processes
+
 SENSOR_TYPES = {"GPS_RAW_INT", "LANDING_TARGET", "SIM_STATE"}
 
 

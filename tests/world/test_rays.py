@@ -61,6 +61,7 @@ def test_box_triangles_match_trimesh_boxes():
     np.testing.assert_allclose(ours.area_faces.sum(), theirs.area_faces.sum())
 
 
+@pytest.mark.slow
 def test_a_world_of_boxes_loads_without_trimesh():
     """The vehicles and the ground station start without importing trimesh (start-up time)."""
     import subprocess

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
+from ground_station.nlp_cache import c_compiler
 from ground_station.support_mpc import CONVERGED, SupportMpc
 from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
@@ -108,7 +107,7 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting, offset):
     branch) or, with the terminal out of reach, beyond it (the far branch)."""
     from scipy.optimize import minimize
 
-    from ground_station.support_mpc import support_cost_numpy
+    from ground_station.support_cost import support_cost_numpy
 
     world, plan, grid, mpc = setting
     control = world.scenario.control
@@ -244,7 +243,7 @@ def test_an_mpc_compiled_outside_the_cache_leaves_no_files_behind(
     control = along_world.scenario.control
     mpc = SupportMpc(control, along_world.map_grid(), along_world.camera)
     assert list(scratch.iterdir()) == []
-    if not _has_compiler():
+    if not c_compiler() is not None:
         return
     plan = read_plan(along_world.scenario)
     work = predict_work(
@@ -259,151 +258,6 @@ def test_an_mpc_compiled_outside_the_cache_leaves_no_files_behind(
         along_world.camera.observable,
     )
     assert result.status == CONVERGED
-
-
-def _tiny_solver():
-    """A two-variable NLP: min (x - p)^2 + (y - 2p)^2 with x + y >= 1, solved by IPOPT."""
-    import casadi as ca
-
-    from ground_station.support_mpc import IPOPT_OPTIONS
-
-    x, p = ca.MX.sym("x", 2), ca.MX.sym("p")
-    nlp = {"x": x, "p": p, "f": (x[0] - p) ** 2 + (x[1] - 2 * p) ** 2, "g": x[0] + x[1]}
-    return nlp, IPOPT_OPTIONS
-
-
-def _compiled_one(name, plugin, nlp, options, fallback_dir):
-    """The library of one NLP, as ``compiled_nlps`` makes it."""
-    from ground_station import support_mpc
-
-    build = support_mpc.NlpBuild(name, plugin, nlp, options)
-    return support_mpc.compiled_nlps([build], fallback_dir)[0]
-
-
-def _has_compiler() -> bool:
-    import shutil
-
-    return shutil.which("gcc") is not None or shutil.which("cc") is not None
-
-
-def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypatch):
-    import tempfile
-
-    import casadi as ca
-
-    from ground_station import support_mpc
-
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    scratch = tmp_path / "tmp"
-    scratch.mkdir()
-    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
-    nlp, options = _tiny_solver()
-
-    def no_fallback() -> str:
-        raise AssertionError("the cache is writable: no fallback directory")
-
-    first = _compiled_one("tiny", "ipopt", nlp, options, no_fallback)
-    if not _has_compiler():
-        assert first is None
-        return
-    assert first is not None and Path(first).parent == tmp_path / "cache" / "bridge-uav-formation"
-    assert list(scratch.iterdir()) == []  # the C source's scratch directory is gone
-    mtime = Path(first).stat().st_mtime_ns
-    interpreted = ca.nlpsol("tiny", "ipopt", nlp, options)
-
-    def no_scratch(*args, **kwargs):
-        raise AssertionError("a cache hit generates no C")
-
-    def no_solver(*args, **kwargs):
-        raise AssertionError("a cache hit builds no solver from the expressions")
-
-    with monkeypatch.context() as hit:
-        hit.setattr(support_mpc.tempfile, "TemporaryDirectory", no_scratch)
-        hit.setattr(support_mpc.ca, "nlpsol", no_solver)
-        again, _ = _tiny_solver()  # the same NLP, built afresh
-        assert _compiled_one("tiny", "ipopt", again, options, no_fallback) == first
-    assert Path(first).stat().st_mtime_ns == mtime
-    compiled = ca.nlpsol("tiny", "ipopt", first, options)
-    expected = interpreted(x0=[0, 0], p=1.5, lbg=1.0, ubg=np.inf)["x"]
-    np.testing.assert_allclose(compiled(x0=[0, 0], p=1.5, lbg=1.0)["x"], expected, atol=1e-9)
-    np.testing.assert_allclose(expected, [[1.5], [3.0]], atol=1e-4)  # IPOPT tol 1e-4
-    # Anything that changes the generated functions is a different library.
-    exact_only = {k: v for k, v in options.items() if k != "calc_lam_p"}
-    changed = {**nlp, "f": nlp["f"] + nlp["x"][0]}
-    others = [
-        _compiled_one("tiny", "ipopt", changed, options, no_fallback),
-        _compiled_one("tiny", "ipopt", nlp, exact_only, no_fallback),
-        _compiled_one("other", "ipopt", nlp, options, no_fallback),
-    ]
-    assert len({first, *others}) == 4
-    # Another plugin needs its own functions (fatrop's Lagrangian Hessian has other outputs).
-    plain = {"print_time": False}
-    by_plugin = {
-        plugin: _compiled_one("tiny", plugin, nlp, plain, no_fallback)
-        for plugin in ("ipopt", "fatrop")
-    }
-    assert by_plugin["ipopt"] != by_plugin["fatrop"]
-    fatrop = ca.nlpsol("tiny", "fatrop", by_plugin["fatrop"], support_mpc.FATROP_OPTIONS)
-    solved = fatrop(x0=[0, 0], p=1.5, lbg=1.0, ubg=10.0)["x"]  # fatrop: finite bounds only
-    np.testing.assert_allclose(solved, expected, atol=1e-4)
-
-
-def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkeypatch):
-    import subprocess
-
-    import casadi as ca
-
-    from ground_station import support_mpc
-
-    if not _has_compiler():
-        return
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    nlp, options = _tiny_solver()
-    shifted = {**nlp, "f": nlp["f"] + nlp["x"][1]}
-    scaled = {**nlp, "f": 2 * nlp["f"]}
-    launched: list[subprocess.Popen] = []
-    popen = subprocess.Popen
-
-    def counting(*args, **kwargs):
-        launched.append(popen(*args, **kwargs))
-        return launched[-1]
-
-    monkeypatch.setattr(support_mpc.subprocess, "Popen", counting)
-
-    def builds(*nlps):
-        return [support_mpc.NlpBuild("tiny", "ipopt", n, options) for n in nlps]
-
-    def no_fallback() -> str:
-        raise AssertionError("the cache is writable: no fallback directory")
-
-    first = support_mpc.compiled_nlps(builds(nlp, shifted), no_fallback)
-    assert len(launched) == 2 and all(p.returncode == 0 for p in launched)
-    assert None not in first and len(set(first)) == 2
-    again = support_mpc.compiled_nlps(builds(nlp, scaled, shifted), no_fallback)
-    assert len(launched) == 3  # only the new one compiled
-    assert (again[0], again[2]) == (first[0], first[1]) and again[1] not in first
-    cache = tmp_path / "cache" / "bridge-uav-formation"
-    assert sorted(path.name for path in cache.iterdir()) == sorted(Path(f).name for f in again)
-    solved = ca.nlpsol("tiny", "ipopt", again[1], options)(x0=[0, 0], p=1.5, lbg=1.0)["x"]
-    np.testing.assert_allclose(solved, [[1.5], [3.0]], atol=1e-4)  # 2x the cost: same optimum
-
-
-def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monkeypatch):
-    import casadi as ca
-
-    blocker = tmp_path / "not-a-directory"
-    blocker.write_text("")
-    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
-    fallback = tmp_path / "private"
-    nlp, options = _tiny_solver()
-    library = _compiled_one("tiny", "ipopt", nlp, options, lambda: str(fallback))
-    if not _has_compiler():
-        assert library is None
-        return
-    assert library is not None and Path(library).parent == fallback
-    solved = ca.nlpsol("tiny", "ipopt", library, options)(x0=[0, 0], p=-1.0, lbg=1.0)["x"]
-    # (x - p, y - 2p) projected onto x + y >= 1 from (-1, -2): the constraint is active
-    np.testing.assert_allclose(solved, [[1.0], [0.0]], atol=1e-4)
 
 
 def _blocked_case(world, mpc: SupportMpc):
@@ -474,8 +328,8 @@ def test_anchors_are_the_nearest_visible_points_shell_by_shell(along_world):
     control, camera = mpc.control, along_world.camera
 
     def shell_by_shell(start, work, fallback):
-        for radius in (0.0, *mpc._shell_radii):
-            points = start[None] if radius == 0 else start + radius * mpc._directions
+        for radius in (0.0, *mpc._anchors._shell_radii):
+            points = start[None] if radius == 0 else start + radius * mpc._anchors._directions
             usable = hermite_zero_slope(mpc.sigma0, mpc.grid, points)
             points = points[usable <= control.support_max_sigma0_m]
             if len(points) == 0:
@@ -492,7 +346,7 @@ def test_anchors_are_the_nearest_visible_points_shell_by_shell(along_world):
     for _ in range(150):
         start = np.array([rng.uniform(-15, 15), rng.uniform(-12, 12), rng.uniform(1, 13)])
         expected = shell_by_shell(start, work, fallback)
-        got = mpc._nearest_visible(start, work, fallback)
+        got = mpc._anchors._nearest_visible(start, work, fallback)
         np.testing.assert_array_equal(got, expected)
         found_at.add(round(float(np.linalg.norm(expected - start)), 6))
     assert 0.0 in found_at and len(found_at) > 3  # the step itself, first and further shells

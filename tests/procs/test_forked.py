@@ -15,7 +15,10 @@ import pytest
 
 from mission.procs.forked import start_forked
 
-pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="POSIX fork only")
+pytestmark = [  # every test here forks
+    pytest.mark.slow,
+    pytest.mark.skipif(not hasattr(os, "fork"), reason="POSIX fork only"),
+]
 
 
 def _report(argv: list[str]) -> int:
@@ -144,6 +147,6 @@ def test_a_process_with_a_second_thread_may_not_fork():
         text=True,
         timeout=60,
         env={**os.environ, "OPENBLAS_NUM_THREADS": "1"},
-        cwd=Path(__file__).resolve().parents[1],
+        cwd=Path(__file__).resolve().parents[2],
     )
     assert result.stdout.split() == ["True", "False", "True"], result.stderr

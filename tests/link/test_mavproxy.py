@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from ground_station.mission_client import MissionClient, MissionTransferError
 from mission.link.waypoints import (
@@ -22,6 +23,8 @@ from mission.link.waypoints import (
 from mission.world.frames import GeodeticFrame
 from tests.mav_client import MavClient
 from tests.processes import stop_process, vehicle_process
+
+pytestmark = pytest.mark.slow  # every test here starts processes
 
 
 def _mavproxy(port: int, command: str, cwd: Path) -> tuple[subprocess.Popen, list[str]]:

@@ -160,10 +160,12 @@ def test_blind_and_fallback():
 
 
 def test_a_cycles_covariances_in_one_batch_equal_one_at_a_time(along_world, plan):
-    """measurements_from_values batches Sigma_GNSS and Sigma_r over the supports: the numbers
+    """localize batches Sigma_GNSS and Sigma_r over the supports: the numbers
     are those of each support alone, bit for bit (with a support lacking an observation and
     one lacking a fix among them)."""
-    from ground_station.measurements import MeasuredValues, measurements_from_values
+    from ground_station.localize import SupportReport, localize
+
+    known = along_world.known()
 
     rng = np.random.default_rng(2)
     for i in range(0, len(plan.work), 3):
@@ -172,16 +174,16 @@ def test_a_cycles_covariances_in_one_batch_equal_one_at_a_time(along_world, plan
             fix = along_world.gnss.sample_fix(y, rng).position_m
             relative = plan.work[i] - y + rng.normal(0, 0.05, 3)
             values.append(
-                MeasuredValues(
+                SupportReport(
                     f"support-{n + 1}",
                     None if n == 2 else fix,
                     None if n == 1 else relative,
                     np.eye(3) * 0.01,
                 )
             )
-        together = measurements_from_values(values, along_world)
+        together = localize(values, known)
         for value, joint in zip(values, together):
-            (alone,) = measurements_from_values([value], along_world)
+            (alone,) = localize([value], known)
             for field in ("fix_m", "sigma_gnss_m2", "relative_m", "sigma_relative_m2"):
                 a, b = getattr(alone, field), getattr(joint, field)
                 assert (a is None) == (b is None), field

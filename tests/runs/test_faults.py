@@ -17,6 +17,8 @@ from mission.analysis.metrics import read_tlog
 from mission.config.scenario import load_scenario
 from tests.processes import ROOT, stop_process, vehicle_pids
 
+pytestmark = pytest.mark.slow  # every test here starts processes
+
 FAULT_SCENARIO = "extends: along\nname: fault-run\n"
 BANNER = re.compile(r"listening on [\d.]+:(\d+), truth port (\d+)")
 
@@ -148,9 +150,9 @@ def test_a_killed_ground_station_ends_the_run_naming_it_with_the_tlog_readable(s
 
 
 def test_the_ground_station_survives_fuzzing_during_upload_and_run(scenario, tmp_path):
-    from tests.test_vehicle_fuzz import _datagrams
+    from tests.fuzzing import hostile_datagrams
 
-    datagrams = _datagrams(seed=2)
+    datagrams = hostile_datagrams(seed=2)
     assert len(datagrams) >= 10_000
     out = tmp_path / "run"
     run = _start_run(scenario, out)

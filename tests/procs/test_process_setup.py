@@ -6,9 +6,12 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from mission.procs.math_threads import THREAD_VARIABLES, use_one_math_thread
 
 
+@pytest.mark.slow
 def test_freezing_the_start_up_heap_exempts_what_was_loaded_from_collection():
     code = (
         "import gc, numpy, pymavlink.dialects.v20.ardupilotmega\n"

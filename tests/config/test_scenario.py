@@ -169,6 +169,7 @@ def test_unknown_epoch_in_table(write_scenario):
         World(load_scenario(str(path)))
 
 
+@pytest.mark.slow
 def test_cli_prints_one_line_and_exits_2(write_scenario, tmp_path):
     path = write_scenario("map: {voxel_size_m: -1}\n")
     result = subprocess.run(

@@ -62,6 +62,7 @@ def _mission_client(client: MavClient) -> MissionClient:
     return MissionClient(client.queue, client.vehicle, SYSID, timeout_s=1.0, retries=3)
 
 
+@pytest.mark.slow
 def test_upload_download_round_trip_is_byte_identical(client, waypoint_file, tmp_path):
     items = [row.to_item() for row in read_waypoints(waypoint_file)]
     mission = _mission_client(client)
@@ -120,6 +121,7 @@ BAD_UPLOADS = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("case", "count", "items", "result"), BAD_UPLOADS, ids=[c[0] for c in BAD_UPLOADS]
 )
@@ -141,6 +143,7 @@ def test_bad_upload_gets_its_nack_and_leaves_the_mission(
     assert _rows(mission.download()) == _rows(original)
 
 
+@pytest.mark.slow
 def test_fence_upload_is_unsupported_and_fence_download_is_empty(client):
     client.send(
         mavlink2.MAVLink_mission_count_message(SYSID, 1, 3, mavlink2.MAV_MISSION_TYPE_FENCE)
@@ -153,6 +156,7 @@ def test_fence_upload_is_unsupported_and_fence_download_is_empty(client):
     assert count is not None and count.count == 0
 
 
+@pytest.mark.slow
 def test_silent_uploader_is_re_requested_then_cancelled(client, waypoint_file):
     original = [row.to_item() for row in read_waypoints(waypoint_file)]
     mission = _mission_client(client)
@@ -165,6 +169,7 @@ def test_silent_uploader_is_re_requested_then_cancelled(client, waypoint_file):
     assert _rows(mission.download()) == _rows(original)
 
 
+@pytest.mark.slow
 def test_clear_set_current_and_item_reached(client, waypoint_file):
     items = [row.to_item() for row in read_waypoints(waypoint_file)]
     mission = _mission_client(client)
@@ -179,6 +184,7 @@ def test_clear_set_current_and_item_reached(client, waypoint_file):
     assert mission.download() == []
 
 
+@pytest.mark.slow
 def test_messages_for_another_system_are_ignored(client, waypoint_file):
     items = [row.to_item() for row in read_waypoints(waypoint_file)]
     mission = _mission_client(client)
@@ -188,6 +194,7 @@ def test_messages_for_another_system_are_ignored(client, waypoint_file):
     assert _rows(mission.download()) == _rows(items)
 
 
+@pytest.mark.slow
 def test_the_last_item_sent_again_gets_the_final_ack_again(client, waypoint_file):
     """When the vehicle's final MISSION_ACK is lost, the ground station repeats the last item:
     the vehicle must acknowledge again, not report a sequence error."""

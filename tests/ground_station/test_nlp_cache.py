@@ -1,0 +1,151 @@
+"""The support MPC's NLPs compiled once with the system C compiler and cached by what they
+are: a cache hit builds nothing, anything that changes the generated code is a new library,
+and an unwritable cache falls back to a private directory."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ground_station.nlp_cache import c_compiler
+from ground_station.support_nlp import FATROP_OPTIONS
+
+
+def _tiny_solver():
+    """A two-variable NLP: min (x - p)^2 + (y - 2p)^2 with x + y >= 1, solved by IPOPT."""
+    import casadi as ca
+
+    from ground_station.support_nlp import IPOPT_OPTIONS
+
+    x, p = ca.MX.sym("x", 2), ca.MX.sym("p")
+    nlp = {"x": x, "p": p, "f": (x[0] - p) ** 2 + (x[1] - 2 * p) ** 2, "g": x[0] + x[1]}
+    return nlp, IPOPT_OPTIONS
+
+
+def _compiled_one(name, plugin, nlp, options, fallback_dir):
+    """The library of one NLP, as ``compiled_nlps`` makes it."""
+    from ground_station import nlp_cache
+
+    build = nlp_cache.NlpBuild(name, plugin, nlp, options)
+    return nlp_cache.compiled_nlps([build], fallback_dir)[0]
+
+
+def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypatch):
+    import tempfile
+
+    import casadi as ca
+
+    from ground_station import nlp_cache
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    nlp, options = _tiny_solver()
+
+    def no_fallback() -> str:
+        raise AssertionError("the cache is writable: no fallback directory")
+
+    first = _compiled_one("tiny", "ipopt", nlp, options, no_fallback)
+    if not c_compiler() is not None:
+        assert first is None
+        return
+    assert first is not None and Path(first).parent == tmp_path / "cache" / "bridge-uav-formation"
+    assert list(scratch.iterdir()) == []  # the C source's scratch directory is gone
+    mtime = Path(first).stat().st_mtime_ns
+    interpreted = ca.nlpsol("tiny", "ipopt", nlp, options)
+
+    def no_scratch(*args, **kwargs):
+        raise AssertionError("a cache hit generates no C")
+
+    def no_solver(*args, **kwargs):
+        raise AssertionError("a cache hit builds no solver from the expressions")
+
+    with monkeypatch.context() as hit:
+        hit.setattr(nlp_cache.tempfile, "TemporaryDirectory", no_scratch)
+        hit.setattr(nlp_cache.ca, "nlpsol", no_solver)
+        again, _ = _tiny_solver()  # the same NLP, built afresh
+        assert _compiled_one("tiny", "ipopt", again, options, no_fallback) == first
+    assert Path(first).stat().st_mtime_ns == mtime
+    compiled = ca.nlpsol("tiny", "ipopt", first, options)
+    expected = interpreted(x0=[0, 0], p=1.5, lbg=1.0, ubg=np.inf)["x"]
+    np.testing.assert_allclose(compiled(x0=[0, 0], p=1.5, lbg=1.0)["x"], expected, atol=1e-9)
+    np.testing.assert_allclose(expected, [[1.5], [3.0]], atol=1e-4)  # IPOPT tol 1e-4
+    # Anything that changes the generated functions is a different library.
+    exact_only = {k: v for k, v in options.items() if k != "calc_lam_p"}
+    changed = {**nlp, "f": nlp["f"] + nlp["x"][0]}
+    others = [
+        _compiled_one("tiny", "ipopt", changed, options, no_fallback),
+        _compiled_one("tiny", "ipopt", nlp, exact_only, no_fallback),
+        _compiled_one("other", "ipopt", nlp, options, no_fallback),
+    ]
+    assert len({first, *others}) == 4
+    # Another plugin needs its own functions (fatrop's Lagrangian Hessian has other outputs).
+    plain = {"print_time": False}
+    by_plugin = {
+        plugin: _compiled_one("tiny", plugin, nlp, plain, no_fallback)
+        for plugin in ("ipopt", "fatrop")
+    }
+    assert by_plugin["ipopt"] != by_plugin["fatrop"]
+    fatrop = ca.nlpsol("tiny", "fatrop", by_plugin["fatrop"], FATROP_OPTIONS)
+    solved = fatrop(x0=[0, 0], p=1.5, lbg=1.0, ubg=10.0)["x"]  # fatrop: finite bounds only
+    np.testing.assert_allclose(solved, expected, atol=1e-4)
+
+
+def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkeypatch):
+    import subprocess
+
+    import casadi as ca
+
+    from ground_station import nlp_cache
+
+    if not c_compiler() is not None:
+        return
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    nlp, options = _tiny_solver()
+    shifted = {**nlp, "f": nlp["f"] + nlp["x"][1]}
+    scaled = {**nlp, "f": 2 * nlp["f"]}
+    launched: list[subprocess.Popen] = []
+    popen = subprocess.Popen
+
+    def counting(*args, **kwargs):
+        launched.append(popen(*args, **kwargs))
+        return launched[-1]
+
+    monkeypatch.setattr(nlp_cache.subprocess, "Popen", counting)
+
+    def builds(*nlps):
+        return [nlp_cache.NlpBuild("tiny", "ipopt", n, options) for n in nlps]
+
+    def no_fallback() -> str:
+        raise AssertionError("the cache is writable: no fallback directory")
+
+    first = nlp_cache.compiled_nlps(builds(nlp, shifted), no_fallback)
+    assert len(launched) == 2 and all(p.returncode == 0 for p in launched)
+    assert None not in first and len(set(first)) == 2
+    again = nlp_cache.compiled_nlps(builds(nlp, scaled, shifted), no_fallback)
+    assert len(launched) == 3  # only the new one compiled
+    assert (again[0], again[2]) == (first[0], first[1]) and again[1] not in first
+    cache = tmp_path / "cache" / "bridge-uav-formation"
+    assert sorted(path.name for path in cache.iterdir()) == sorted(Path(f).name for f in again)
+    solved = ca.nlpsol("tiny", "ipopt", again[1], options)(x0=[0, 0], p=1.5, lbg=1.0)["x"]
+    np.testing.assert_allclose(solved, [[1.5], [3.0]], atol=1e-4)  # 2x the cost: same optimum
+
+
+def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monkeypatch):
+    import casadi as ca
+
+    blocker = tmp_path / "not-a-directory"
+    blocker.write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
+    fallback = tmp_path / "private"
+    nlp, options = _tiny_solver()
+    library = _compiled_one("tiny", "ipopt", nlp, options, lambda: str(fallback))
+    if not c_compiler() is not None:
+        assert library is None
+        return
+    assert library is not None and Path(library).parent == fallback
+    solved = ca.nlpsol("tiny", "ipopt", library, options)(x0=[0, 0], p=-1.0, lbg=1.0)["x"]
+    # (x - p, y - 2p) projected onto x + y >= 1 from (-1, -2): the constraint is active
+    np.testing.assert_allclose(solved, [[1.0], [0.0]], atol=1e-4)
