@@ -28,7 +28,17 @@ def build_parser() -> OneLineArgumentParser:
     commands = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=OneLineArgumentParser
     )
+    _add_world_parser(commands)
+    _add_plan_parser(commands)
+    _add_analyze_parser(commands)
+    _add_bench_parser(commands)
+    _add_run_parser(commands)
+    _add_batch_parser(commands)
+    return parser
 
+
+def _add_world_parser(commands) -> None:
+    """``mission world``'s arguments."""
     world = commands.add_parser("world", help="inspect a scenario's world (GNSS, structure, zones)")
     world.add_argument(
         "scenario",
@@ -50,6 +60,9 @@ def build_parser() -> OneLineArgumentParser:
         help="draw structure, zones, sky plot and sigma_0 slices",
     )
 
+
+def _add_plan_parser(commands) -> None:
+    """``mission plan``'s arguments."""
     plan = commands.add_parser("plan", help="plan the support UAVs' paths; write waypoint files")
     plan.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
     plan.add_argument(
@@ -60,6 +73,9 @@ def build_parser() -> OneLineArgumentParser:
     )
     plan.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the plan")
 
+
+def _add_analyze_parser(commands) -> None:
+    """``mission analyze``'s arguments."""
     analyze = commands.add_parser("analyze", help="recompute a run's metrics from its tlog")
     analyze.add_argument("run", type=Path, metavar="DIR|TLOG")
     analyze.add_argument("--scenario", help="scenario of the run (default: from summary.json)")
@@ -67,6 +83,9 @@ def build_parser() -> OneLineArgumentParser:
         "--plots", action="store_true", help="draw the paper's figures into DIR/plots/"
     )
 
+
+def _add_bench_parser(commands) -> None:
+    """``mission bench``'s arguments."""
     bench = commands.add_parser("bench", help="run the benchmarks and print their medians")
     bench.add_argument("--json", action="store_true", help="print one JSON object")
     bench.add_argument(
@@ -76,6 +95,9 @@ def build_parser() -> OneLineArgumentParser:
         help="run only this group (repeatable)",
     )
 
+
+def _add_run_parser(commands) -> None:
+    """``mission run``'s arguments."""
     run = commands.add_parser("run", help="run a mission: vehicle processes + ground station")
     run.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
     run.add_argument("--method", choices=["ac", "nac"], default="ac")
@@ -112,6 +134,9 @@ def build_parser() -> OneLineArgumentParser:
     )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
+
+def _add_batch_parser(commands) -> None:
+    """``mission batch``'s arguments."""
     batch = commands.add_parser(
         "batch", help="run scenarios x methods x seeds in parallel; write Table 3"
     )
@@ -122,7 +147,6 @@ def build_parser() -> OneLineArgumentParser:
     batch.add_argument(
         "--out", type=Path, default=Path("logs/batch"), help="default logs/batch (resumable)"
     )
-    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
