@@ -1,0 +1,240 @@
+"""What each ``python -m mission`` sub-command does, given its parsed arguments (the parsers
+are in :mod:`mission.cli`). Heavy imports happen inside each, so ``--help`` and bad arguments
+answer at once."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from mission.config.errors import InputError
+from mission.link.impairment import link_settings
+from mission.procs.cli_common import parse_point
+
+DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
+
+
+def world(args: argparse.Namespace) -> int:
+    """``mission world``."""
+    point = parse_point(args.at, "--at") if args.at is not None else None
+    from mission.world.model import World
+
+    if args.plot is not None:
+        _check_output_path(args.plot, "--plot", ".png")
+    world = World.load(args.scenario)
+    if point is not None:
+        from mission.analysis.world_report import point_report
+
+        print(json.dumps(point_report(world, np.array(point))))
+    else:
+        from mission.analysis.world_report import summary_text
+
+        print(summary_text(world))
+    if args.plot is not None:
+        from mission.analysis.world_plot import plot_world
+
+        plot_world(world, np.array(point or DEFAULT_PLOT_POINT), args.plot)
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    """``mission run``."""
+    import time
+
+    from mission.config.scenario import load_scenario
+    from mission.runs.orchestrator import RunFailed, RunOptions, run_mission
+
+    if args.exit_with_parent:
+        from mission.procs.cli_common import die_with_parent
+
+        die_with_parent()
+    scenario = load_scenario(args.scenario)
+    _preflight(scenario)
+    if args.realtime and not 0 < args.speedup <= 1000:
+        raise InputError("command line", "--speedup", "must be in (0, 1000]")
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
+    if args.signing_key is not None:
+        from mission.link.signing import read_signing_key
+
+        read_signing_key(args.signing_key)  # a bad key fails here, before anything starts
+    if args.observer is not None:
+        from mission.link.mavlink_udp import parse_address
+
+        try:
+            parse_address(args.observer, "--observer")
+        except ValueError as error:
+            raise InputError("command line", "--observer", str(error)) from None
+    link = link_settings(args)
+    options = RunOptions(
+        args.scenario,
+        args.method,
+        args.seed,
+        out,
+        args.speedup if args.realtime else None,
+        args.signing_key.resolve() if args.signing_key else None,
+        args.observer,
+        link,
+        args.mpc_helper,
+        args.process_start,
+    )
+    print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
+    try:
+        summary = run_mission(options, scenario)
+    except RunFailed as error:
+        print(f"run failed: {error}; logs kept in {out}", file=sys.stderr)
+        return 1
+    error = summary["work_error_m"]
+    done = (
+        f"completed at {summary['completion_time_s']:.1f} s"
+        if summary["completed"]
+        else f"NOT completed within {scenario.run.timeout_s:g} s"
+    )
+    print(
+        f"{done}; {summary['control_cycles']} cycles; steps in multipath "
+        f"{summary['multipath_steps_total']} {summary['multipath_steps']}; work UAV error "
+        f"mean {error['mean']} m; wall {summary['wall_time_s']:.1f} s, real-time factor "
+        f"{summary['realtime_factor']}; summary in {out / 'summary.json'}"
+    )
+    return 0
+
+
+def batch(args: argparse.Namespace) -> int:
+    """``mission batch``."""
+    from mission.config.scenario import load_scenario
+    from mission.runs.batch import BatchOptions, Trial, run_batch
+
+    if not 1 <= args.trials <= 1000:
+        raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
+    if not 1 <= args.jobs <= 64:
+        raise InputError("command line", "--jobs", f"must be in [1, 64], got {args.jobs}")
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    if not methods or any(m not in ("ac", "nac") for m in methods):
+        raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
+    scenarios = [load_scenario(s) for s in args.scenarios]
+    for scenario in scenarios:
+        _preflight(scenario)
+    names = [s.name for s in scenarios]
+    if len(set(names)) != len(names):
+        raise InputError("command line", "SCENARIO", f"the same scenario twice: {names}")
+    trials = [
+        Trial(scenario, name, method, seed)
+        for scenario, name in zip(args.scenarios, names)
+        for method in methods
+        for seed in range(args.trials)
+    ]
+    try:
+        result = run_batch(BatchOptions(trials, args.out, args.jobs))
+    except KeyboardInterrupt:
+        print(f"batch interrupted; finished runs are kept in {args.out}: run again to resume")
+        return 130
+    print((args.out / "table.md").read_text(), end="")
+    print(
+        f"{result['finished']} runs finished, {result['skipped']} already done, "
+        f"{len(result['failed'])} failed; wall {result['wall_time_s']:.1f} s; "
+        f"results in {args.out}"
+    )
+    return 1 if result["failed"] else 0
+
+
+def _preflight(scenario) -> None:
+    """Everything a run reads from files, checked before any process starts."""
+    from mission.link.plan_files import read_plan
+    from mission.world.structure import load_mesh_file
+
+    mesh_file = scenario.world.structure.mesh_file
+    if mesh_file is not None:
+        load_mesh_file(Path(mesh_file), scenario.source)
+    read_plan(scenario)  # every vehicle's waypoint file
+
+
+def plan(args: argparse.Namespace) -> int:
+    """``mission plan``."""
+    from mission.link.plan_files import write_plan
+    from mission.planning.planner import plan_supports
+    from mission.planning.zone_placement import place_along, place_wall
+    from mission.world.model import World
+
+    if args.plot is not None:
+        _check_output_path(args.plot, "--plot", ".png")
+    world = World.load(args.scenario)
+    plan = plan_supports(world)
+    out = args.out if args.out is not None else Path(world.scenario.task.waypoints_dir)
+    for path in write_plan(plan, world.scenario, out):
+        print(f"wrote {path}")
+    try:
+        along, segment = place_along(plan, world.workspace)
+        print(
+            f"an Along zone for this plan (segment w_1,{segment + 1} -> w_1,{segment + 2}): "
+            f"min_m {list(along.min_m)}, max_m {list(along.max_m)}"
+        )
+    except ValueError as reason:
+        print(f"an Along zone: {reason}")
+    try:
+        wall = place_wall(plan, world.workspace)
+        print(
+            f"a Wall zone for this plan (around w_1,6): min_m {list(wall.min_m)}, "
+            f"max_m {list(wall.max_m)}"
+        )
+    except (ValueError, IndexError):
+        print("a Wall zone: no place on this plan")
+    if args.plot is not None:
+        from mission.planning.plan_plot import plot_plan
+
+        plot_plan(world, plan, args.plot)
+    return 0
+
+
+def analyze(args: argparse.Namespace) -> int:
+    """``mission analyze``."""
+    from mission.analysis.metrics import analyze_tlog
+    from mission.config.scenario import load_scenario
+
+    tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
+    if not tlog.is_file():
+        raise InputError(str(args.run), "", "no gcs.tlog here (give a run directory or a tlog)")
+    summary_path = tlog.parent / "summary.json"
+    previous = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
+    scenario_name = args.scenario or previous.get("scenario_source") or previous.get("scenario")
+    if scenario_name is None:
+        raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
+    scenario = load_scenario(scenario_name)
+    metrics = analyze_tlog(tlog, scenario)
+    merged = {**previous, **metrics}
+    if previous:
+        from mission.procs.atomic import write_text_atomically
+
+        write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
+    print(json.dumps(metrics))
+    if args.plots:
+        from mission.analysis.metrics import read_tlog
+        from mission.analysis.run_plot import plot_run
+        from mission.world.model import World
+
+        trace = read_tlog(tlog, scenario)
+        for path in plot_run(trace, World(scenario), tlog.parent / "g", tlog.parent / "plots"):
+            print(f"wrote {path}")
+    return 0
+
+
+def bench(args: argparse.Namespace) -> int:
+    """``mission bench``."""
+    from mission.runs.bench import format_table, run_benchmarks
+
+    results = run_benchmarks(args.only)
+    if args.json:
+        print(json.dumps({r.name: r.value for r in results}))
+    else:
+        print(format_table(results))
+    return 0
+
+
+def _check_output_path(path: Path, flag: str, suffix: str) -> None:
+    if path.suffix.lower() != suffix:
+        raise InputError("command line", flag, f"{path}: the file name must end in {suffix}")
+    if not path.parent.resolve().is_dir():
+        raise InputError("command line", flag, f"{path}: directory {path.parent} does not exist")
