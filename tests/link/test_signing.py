@@ -43,7 +43,10 @@ def test_a_signed_vehicle_obeys_only_signed_traffic(key_file, along, client_key,
     frame = GeodeticFrame(along.world.anchor)
     with vehicle_process("support-1", "--signing-key", str(key_file)) as vehicle:
         client = MavClient(vehicle.address, signing_key=client_key)
-        clock = MavClient(vehicle.address, signing_key=KEY)  # a signed peer drives the clock
+        # a signed peer drives the clock, as a stream of its own (system 254): two senders on
+        # one signed stream (same system, component and link) would have their timestamps
+        # interleave, and the vehicle would refuse the older ones as replays
+        clock = MavClient(vehicle.address, system_id=254, signing_key=KEY)
         upload = _mission_count(client)
         mode = client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 4, system_id=2)
         arm = client.command(mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 1, system_id=2)

@@ -332,7 +332,7 @@ def test_ctrl_c_stops_every_process_of_a_run_and_keeps_its_logs(tmp_path):
     finally:
         if run.poll() is None:
             os.killpg(run.pid, signal.SIGKILL)
-    assert run.returncode == 130 and "interrupted" in stdout + stderr
+    assert run.returncode == 130 and "interrupted" in stdout + stderr, stdout + stderr
     assert _gone(out)
     assert (out / "gcs.tlog").stat().st_size > 0 and "steps to t=" in (out / "work.log").read_text()
 
