@@ -73,7 +73,12 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     options.out_dir.mkdir(parents=True, exist_ok=True)
     children: list[Child] = []
     start = time.monotonic()
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    # Ctrl-C and SIGTERM stop the run, even where the caller started it with SIGINT ignored
+    # (a background job): its forked children take Python's default handlers back.
+    previous = {
+        signal.SIGTERM: signal.signal(signal.SIGTERM, _raise_interrupt),
+        signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
+    }
     try:
         gcs = _start_processes(options, scenario, children)
         _supervise(gcs, children, required={"work"})
@@ -83,7 +88,8 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
             )
     finally:
         _stop_all(children)
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
     summary = _summary(options, scenario, time.monotonic() - start)
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary

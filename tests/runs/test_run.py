@@ -292,8 +292,13 @@ def test_an_observer_sees_every_vehicle_without_disturbing_the_run(scenario, tmp
     assert _children_of(scenario) == []
 
 
-def _start_in_own_group(out: Path) -> subprocess.Popen:
-    """`mission run along` in a process group of its own, as a terminal would start it."""
+def _start_in_own_group(out: Path, sigint_ignored: bool = False) -> subprocess.Popen:
+    """`mission run along` in a process group of its own, as a terminal would start it (or as
+    a shell starts a background job: with SIGINT ignored)."""
+
+    def ignore_sigint() -> None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
     return subprocess.Popen(
         [sys.executable, "-m", "mission", "run", "along", "--out", str(out), "--mpc-helper"],
         stdout=subprocess.PIPE,
@@ -301,6 +306,7 @@ def _start_in_own_group(out: Path) -> subprocess.Popen:
         text=True,
         cwd=ROOT,
         start_new_session=True,
+        preexec_fn=ignore_sigint if sigint_ignored else None,
     )
 
 
@@ -319,11 +325,15 @@ def _gone(out: Path, timeout_s: float = 15.0) -> bool:
     return _processes_of(out) == []
 
 
-def test_ctrl_c_stops_every_process_of_a_run_and_keeps_its_logs(tmp_path):
+@pytest.mark.parametrize("sigint_ignored", [False, True], ids=["terminal", "background-job"])
+def test_ctrl_c_stops_every_process_of_a_run_and_keeps_its_logs(tmp_path, sigint_ignored):
     """Ctrl-C reaches the run's whole process group: the ground station, its forked helper
-    and the forked vehicles all end, and the run says it was interrupted."""
+    and the forked vehicles all end, and the run says it was interrupted; also when it was
+    started with SIGINT ignored, as a shell starts a background job (an explicit SIGINT then
+    still stops it, and the run does not mistake its interrupted ground station for a
+    failure)."""
     out = tmp_path / "interrupted"
-    run = _start_in_own_group(out)
+    run = _start_in_own_group(out, sigint_ignored)
     try:
         _wait_for_cycles(out, 5)
         assert len(_processes_of(out)) == 7  # run, station, helper, four vehicles
