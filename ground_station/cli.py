@@ -27,7 +27,10 @@ from mission.world.model import KnownWorld
 
 def build_parser() -> OneLineArgumentParser:
     """Arguments of the ground-station process."""
-    parser = OneLineArgumentParser(prog="python -m ground_station", description=__doc__)
+    parser = OneLineArgumentParser(
+        prog="python -m ground_station",
+        description="The ground station of one mission: fusion, the map G, the MPCs.",
+    )
     parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
     parser.add_argument(
         "--method",
@@ -53,7 +56,7 @@ def build_parser() -> OneLineArgumentParser:
         metavar="DIR",
         help="the vehicles' waypoint files (default: the scenario's plan)",
     )
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=int, default=0, help="seed of the fusion's random draws")
     parser.add_argument(
         "--out",
         type=Path,

@@ -18,7 +18,10 @@ DEFAULT_SCENARIO = "along"
 
 def build_parser() -> OneLineArgumentParser:
     """The argument parser with every subcommand."""
-    parser = OneLineArgumentParser(prog="python -m mission", description=__doc__)
+    parser = OneLineArgumentParser(
+        prog="python -m mission",
+        description="Run, batch, analyse and inspect missions of the bridge-inspection UAVs.",
+    )
     commands = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=OneLineArgumentParser
     )
@@ -58,7 +61,12 @@ def _add_world_parser(commands) -> None:
 def _add_plan_parser(commands) -> None:
     """``mission plan``'s arguments."""
     plan = commands.add_parser("plan", help="plan the support UAVs' paths; write waypoint files")
-    plan.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
+    plan.add_argument(
+        "scenario",
+        nargs="?",
+        default=DEFAULT_SCENARIO,
+        help="embedded name (along, wall) or YAML path",
+    )
     plan.add_argument(
         "--out",
         type=Path,
@@ -71,7 +79,9 @@ def _add_plan_parser(commands) -> None:
 def _add_analyze_parser(commands) -> None:
     """``mission analyze``'s arguments."""
     analyze = commands.add_parser("analyze", help="recompute a run's metrics from its tlog")
-    analyze.add_argument("run", type=Path, metavar="DIR|TLOG")
+    analyze.add_argument(
+        "run", type=Path, metavar="DIR|TLOG", help="a run's directory, or its gcs.tlog"
+    )
     analyze.add_argument("--scenario", help="scenario of the run (default: from summary.json)")
     analyze.add_argument(
         "--plots", action="store_true", help="draw the paper's figures into DIR/plots/"
@@ -93,9 +103,19 @@ def _add_bench_parser(commands) -> None:
 def _add_run_parser(commands) -> None:
     """``mission run``'s arguments."""
     run = commands.add_parser("run", help="run a mission: vehicle processes + ground station")
-    run.add_argument("scenario", nargs="?", default=DEFAULT_SCENARIO)
-    run.add_argument("--method", choices=["ac", "nac"], default="ac")
-    run.add_argument("--seed", type=int, default=0)
+    run.add_argument(
+        "scenario",
+        nargs="?",
+        default=DEFAULT_SCENARIO,
+        help="embedded name (along, wall) or YAML path",
+    )
+    run.add_argument(
+        "--method",
+        choices=["ac", "nac"],
+        default="ac",
+        help="ac: adaptive control (G learned); nac: the baseline without the update",
+    )
+    run.add_argument("--seed", type=int, default=0, help="seed of every random draw of the run")
     run.add_argument(
         "--out", type=Path, metavar="DIR", help="default logs/<scenario>-<method>-<seed>-<time>/"
     )
@@ -134,7 +154,13 @@ def _add_batch_parser(commands) -> None:
     batch = commands.add_parser(
         "batch", help="run scenarios x methods x seeds in parallel; write Table 3"
     )
-    batch.add_argument("scenarios", nargs="*", default=["along", "wall"], metavar="SCENARIO")
+    batch.add_argument(
+        "scenarios",
+        nargs="*",
+        default=["along", "wall"],
+        metavar="SCENARIO",
+        help="embedded names or YAML paths",
+    )
     batch.add_argument("--trials", type=int, default=15, help="seeds 0..N-1 (default 15)")
     batch.add_argument("--methods", default="ac,nac", help="comma-separated (default ac,nac)")
     batch.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")

@@ -88,19 +88,27 @@ def run(args: argparse.Namespace) -> int:
     except RunFailed as error:
         print(f"run failed: {error}; logs kept in {out}", file=sys.stderr)
         return 1
-    error = summary["work_error_m"]
+    print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
+    return 0
+
+
+def run_line(summary: dict, timeout_s: float) -> str:
+    """A finished run in one line of text."""
     done = (
         f"completed at {summary['completion_time_s']:.1f} s"
         if summary["completed"]
-        else f"NOT completed within {scenario.run.timeout_s:g} s"
+        else f"NOT completed within {timeout_s:g} s"
     )
-    print(
+    per_support = ", ".join(f"{name} {n}" for name, n in summary["multipath_steps"].items())
+    mean = summary["work_error_m"]["mean"]
+    error = "no estimate" if mean is None else f"mean {mean:.4f} m"
+    factor = summary["realtime_factor"]
+    speed = "" if factor is None else f", {factor:.0f}x real time"
+    return (
         f"{done}; {summary['control_cycles']} cycles; steps in multipath "
-        f"{summary['multipath_steps_total']} {summary['multipath_steps']}; work UAV error "
-        f"mean {error['mean']} m; wall {summary['wall_time_s']:.1f} s, real-time factor "
-        f"{summary['realtime_factor']}; summary in {out / 'summary.json'}"
+        f"{summary['multipath_steps_total']} ({per_support}); work UAV error {error}; "
+        f"wall {summary['wall_time_s']:.1f} s{speed}"
     )
-    return 0
 
 
 def batch(args: argparse.Namespace) -> int:
@@ -162,10 +170,11 @@ def plan(args: argparse.Namespace) -> int:
     if args.plot is not None:
         _check_output_path(args.plot, "--plot", ".png")
     world = World.load(args.scenario)
+    out = plan_directory(args.out, world.scenario)
     plan = plan_supports(world)
-    out = args.out if args.out is not None else Path(world.scenario.task.waypoints_dir)
     for path in write_plan(plan, world.scenario, out):
         print(f"wrote {path}")
+    print(f"to fly it: task: {{waypoints_dir: {out.resolve()}}} in the scenario")
     try:
         along, segment = place_along(plan, world.workspace)
         print(
@@ -187,6 +196,20 @@ def plan(args: argparse.Namespace) -> int:
 
         plot_plan(world, plan, args.plot)
     return 0
+
+
+def plan_directory(out: Path | None, scenario) -> Path:
+    """Where ``mission plan`` writes: ``--out``, else ``<name>-plan/`` beside the user's
+    scenario file, or in the current directory for an embedded scenario. Never inside the
+    installed package (its shipped plans would change every later run)."""
+    package = Path(__file__).resolve().parent
+    if out is None:
+        source = Path(scenario.source)
+        inside = source.resolve().is_relative_to(package)
+        out = (Path.cwd() if inside else source.parent) / f"{scenario.name}-plan"
+    if out.resolve().is_relative_to(package):
+        raise InputError("command line", "--out", f"{out} is inside the installed package")
+    return out
 
 
 def analyze(args: argparse.Namespace) -> int:

@@ -32,7 +32,9 @@ from vehicle_sim.vehicle import Vehicle
 
 def build_parser() -> OneLineArgumentParser:
     """Arguments of a vehicle process."""
-    parser = OneLineArgumentParser(prog="python -m vehicle_sim", description=__doc__)
+    parser = OneLineArgumentParser(
+        prog="python -m vehicle_sim", description="One simulated UAV speaking MAVLink 2 over UDP."
+    )
     parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
     parser.add_argument("--vehicle", required=True, help="work or support-N")
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on")
@@ -46,7 +48,12 @@ def build_parser() -> OneLineArgumentParser:
         metavar="HOST:PORT",
         help="also stream to this address (repeatable), as SITL does for a GCS",
     )
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of every random draw (with the vehicle's instance)",
+    )
     pacing = parser.add_mutually_exclusive_group()
     pacing.add_argument(
         "--lockstep",

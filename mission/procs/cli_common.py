@@ -12,8 +12,25 @@ from mission.config.errors import InputError
 EXIT_BAD_INPUT = 2
 
 
+class DefaultsHelpFormatter(argparse.HelpFormatter):
+    """Help that ends each argument's text with its default, unless the text already says
+    it or there is none to say (an unset option, a flag that is off)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        unset = action.default is None or action.default is False
+        if "default" in text or unset or action.default == argparse.SUPPRESS:
+            return text
+        return f"{text} (default: %(default)s)"
+
+
 class OneLineArgumentParser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are a single line on stderr and exit status 2."""
+    """An ArgumentParser whose errors are a single line on stderr and exit status 2, and whose
+    help shows every argument's default."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("formatter_class", DefaultsHelpFormatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> None:  # type: ignore[override]
         """Report a usage error on one line and exit with status 2."""

@@ -151,6 +151,7 @@ def table_rows(rows: list[dict]) -> list[dict]:
                     "time_reduction_pct": _round(times.reduction_pct) if is_ac else None,
                     "time_wilcoxon_p": _round(times.p_value, 4) if is_ac else None,
                     "pairs": steps.pairs if is_ac else None,
+                    "time_pairs": times.pairs if is_ac else None,
                 }
             )
     return out
@@ -169,8 +170,8 @@ def table_markdown(table: list[dict]) -> str:
         rate = "-" if r["completion_rate"] is None else f"{100 * r['completion_rate']:.0f} %"
         lines.append(
             f"| {r['scenario']} | {r['method'].upper()} | {r['runs']} | {steps} | {time} | {rate} "
-            f"| {_reduction(r['steps_reduction_pct'], r['steps_wilcoxon_p'])} "
-            f"| {_reduction(r['time_reduction_pct'], r['time_wilcoxon_p'])} |"
+            f"| {_reduction(r['steps_reduction_pct'], r['steps_wilcoxon_p'], r['pairs'])} "
+            f"| {_reduction(r['time_reduction_pct'], r['time_wilcoxon_p'], r['time_pairs'])} |"
         )
     return "\n".join(lines) + "\n"
 
@@ -256,8 +257,15 @@ def _pm(mean: float | None, std: float | None) -> str:
     return f"{mean:.1f}" if std is None else f"{mean:.1f} +/- {std:.1f}"
 
 
-def _reduction(percent: float | None, p: float | None) -> str:
+MIN_PAIRS_FOR_5_PERCENT = 6  # below, no two-sided signed-rank p can reach 0.05 (2 / 2^n)
+
+
+def _reduction(percent: float | None, p: float | None, pairs: int | None) -> str:
     if percent is None:
         return ""
     change = -percent  # shown as the paper does: AC's change against NAC
-    return f"{change:+.1f} %" + ("" if p is None else f" (p = {p:.3g})")
+    if p is None:
+        return f"{change:+.1f} %"
+    if pairs is not None and pairs < MIN_PAIRS_FOR_5_PERCENT:
+        return f"{change:+.1f} % (p = {p:.3g}; {pairs} pairs: too few for the test to mean much)"
+    return f"{change:+.1f} % (p = {p:.3g})"

@@ -1,4 +1,4 @@
-"""A trial: one (scenario, method, seed) run of a batch, and where its results live."""
+"""A trial: one (scenario, method, seed) run of a batch, and the directory its results go to."""
 
 from __future__ import annotations
 

@@ -14,7 +14,13 @@ from pathlib import Path
 import pytest
 
 from mission.runs.batch import BatchOptions, Trial, finished_summary, run_batch
-from mission.runs.batch_table import compare, method_stats, result_rows, table_rows
+from mission.runs.batch_table import (
+    compare,
+    method_stats,
+    result_rows,
+    table_markdown,
+    table_rows,
+)
 from tests.processes import ROOT
 
 
@@ -64,6 +70,25 @@ def test_table_statistics_match_a_hand_computation():
     assert times.pairs == 2 and times.reduction_pct == pytest.approx(100 * 50 / 255)
     table = table_rows(rows)
     assert [(r["method"], r["steps_reduction_pct"]) for r in table] == [("ac", 60.0), ("nac", None)]
+    assert (table[0]["pairs"], table[0]["time_pairs"]) == (3, 2)
+
+
+def test_a_p_value_from_too_few_pairs_says_so():
+    """Below six pairs no two-sided signed-rank p reaches 0.05 (2 / 2^n): the table says the
+    pairs are too few; with fifteen it gives p plainly."""
+    few = table_markdown(table_rows(result_rows(*_fake_batch())))
+    assert "3 pairs: too few" in few and "2 pairs: too few" in few
+    ac = {seed: 10.0 + seed for seed in range(15)}
+    nac = {seed: 40.0 + seed for seed in range(15)}
+    assert compare(ac, nac).p_value < 0.001
+    row = {
+        "scenario": "s", "method": "ac", "runs": 15, "steps_mean": 17.0, "steps_std": 4.5,
+        "completion_time_mean_s": None, "completion_time_std_s": None, "completion_rate": 1.0,
+        "steps_reduction_pct": 64.8, "steps_wilcoxon_p": 0.0001, "time_reduction_pct": None,
+        "time_wilcoxon_p": None, "pairs": 15, "time_pairs": 0,
+    }  # fmt: skip
+    text = table_markdown([row])
+    assert "-64.8 % (p = 0.0001) |" in text and "too few" not in text
 
 
 def test_a_finished_batch_is_skipped_and_its_tables_rewritten(tmp_path):
@@ -86,7 +111,7 @@ def test_a_finished_batch_is_skipped_and_its_tables_rewritten(tmp_path):
         ("ac", "1", "20"),
     ]
     assert (
-        "| along | AC | 3 | 20.0 +/- 10.0 | 205.0 +/- 7.1 | 67 % | -60.0 % (p = 0.25)"
+        "| along | AC | 3 | 20.0 +/- 10.0 | 205.0 +/- 7.1 | 67 % | -60.0 % (p = 0.25; 3 pairs: too"
         in (tmp_path / "table.md").read_text()
     )
     assert (tmp_path / "boxplots.png").read_bytes()[:4] == b"\x89PNG"

@@ -1,0 +1,49 @@
+"""``mission plan`` writes beside the user's scenario or in the current directory, never into
+the installed package."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import mission
+from mission.cli import entry_point
+from mission.config.errors import InputError
+from mission.config.scenario import load_scenario
+from mission.subcommands import plan_directory
+
+PACKAGE = Path(mission.__file__).resolve().parent
+SHIPPED = PACKAGE / "scenarios" / "plans" / "bridge"
+
+
+def test_an_embedded_scenario_is_planned_into_the_current_directory(monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    assert plan_directory(None, load_scenario("wall")) == tmp_path / "wall-plan"
+
+
+def test_a_users_scenario_is_planned_beside_its_file(write_scenario, tmp_path, monkeypatch):
+    monkeypatch.chdir("/")
+    path = write_scenario("extends: along\nname: mine\n")
+    scenario = load_scenario(str(path))
+    assert Path(scenario.task.waypoints_dir).is_relative_to(PACKAGE)  # the shipped plan is read
+    assert plan_directory(None, scenario) == path.parent / "mine-plan"
+    assert plan_directory(tmp_path / "x", scenario) == tmp_path / "x"
+
+
+def test_the_package_is_refused_as_an_output(write_scenario):
+    scenario = load_scenario(str(write_scenario("extends: along\n")))
+    with pytest.raises(InputError, match=r"--out.*inside the installed package"):
+        plan_directory(SHIPPED, scenario)
+
+
+def test_planning_leaves_the_shipped_plans_alone(monkeypatch, tmp_path, capsys):
+    before = {p.name: p.read_bytes() for p in SHIPPED.iterdir()}
+    monkeypatch.chdir(tmp_path)
+    assert entry_point(["plan", "along"]) == 0
+    written = tmp_path / "along-plan"
+    assert sorted(p.name for p in written.iterdir()) == sorted(before)
+    assert {p.name: p.read_bytes() for p in SHIPPED.iterdir()} == before
+    assert {p.name: p.read_bytes() for p in written.iterdir()} == before  # the same plan
+    assert f"waypoints_dir: {written}" in capsys.readouterr().out
+    assert entry_point(["plan", "along", "--out", str(SHIPPED)]) == 2

@@ -1,0 +1,33 @@
+"""What the command line prints reads as text."""
+
+from __future__ import annotations
+
+from mission.subcommands import run_line
+
+SUMMARY = {
+    "completed": True,
+    "completion_time_s": 254.5,
+    "control_cycles": 509,
+    "multipath_steps": {"support-1": 13, "support-2": 1, "support-3": 0},
+    "multipath_steps_total": 14,
+    "work_error_m": {"mean": 0.1408, "p95": 0.2686, "max": 0.6355},
+    "wall_time_s": 4.21,
+    "realtime_factor": 60.49,
+}
+
+
+def test_the_end_of_run_line_is_text_not_a_python_repr():
+    line = run_line(SUMMARY, 900.0)
+    assert line == (
+        "completed at 254.5 s; 509 cycles; steps in multipath 14 (support-1 13, support-2 1, "
+        "support-3 0); work UAV error mean 0.1408 m; wall 4.2 s, 60x real time"
+    )
+    assert "{" not in line and "'" not in line
+
+
+def test_a_run_that_did_not_complete_or_estimate_says_so():
+    summary = {**SUMMARY, "completed": False, "completion_time_s": None}
+    summary["work_error_m"] = {"mean": None, "p95": None, "max": None}
+    line = run_line(summary, 900.0)
+    assert line.startswith("NOT completed within 900 s;")
+    assert "work UAV error no estimate" in line
