@@ -18,10 +18,13 @@ from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
 from mission.procs.cli_common import (
     OneLineArgumentParser,
+    check_port,
+    check_seed,
     die_with_parent,
     name_this_process,
     run_guarded,
 )
+from mission.procs.outputs import check_output_dir, check_output_file
 from mission.world.model import KnownWorld
 
 
@@ -110,8 +113,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     name_this_process("ground_station")  # forked by `mission run`, it has no own argv
     if args.exit_with_parent:
         die_with_parent()
+    check_seed(args.seed)
     world = KnownWorld.load(args.scenario)
     scenario = world.scenario
+    if args.vehicles is None:
+        check_port(args.base_port, "--base-port")
+        check_port(args.base_port + scenario.task.supports, "--base-port")
     vehicles = _vehicle_addresses(args, scenario.task.supports)
     if args.speedup is not None and not 0 < args.speedup <= 1000:
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
@@ -121,6 +128,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     for name in vehicles:  # every waypoint file is checked before anything is started
         read_waypoints_file(waypoints / f"{name}.waypoints")
     out = args.out or Path("logs") / f"gcs-{time.strftime('%Y%m%d-%H%M%S')}"
+    check_output_dir(out, "--out")
+    if args.tlog is not None:
+        check_output_file(args.tlog, "--tlog")
     config = StationConfig(
         adaptive=args.method == "ac",
         vehicles=vehicles,

@@ -120,7 +120,9 @@ def _add_run_parser(commands) -> None:
         "--out", type=Path, metavar="DIR", help="default logs/<scenario>-<method>-<seed>-<time>/"
     )
     run.add_argument("--realtime", action="store_true", help="real time instead of lockstep")
-    run.add_argument("--speedup", type=float, default=1.0, help="with --realtime (default 1)")
+    run.add_argument(
+        "--speedup", type=float, help="with --realtime: this many times faster (default 1)"
+    )
     run.add_argument(
         "--signing-key", type=Path, metavar="FILE", help="sign every link (32-byte secret)"
     )

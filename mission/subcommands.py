@@ -13,7 +13,8 @@ import numpy as np
 
 from mission.config.errors import InputError
 from mission.link.impairment import link_settings
-from mission.procs.cli_common import parse_point
+from mission.procs.cli_common import check_seed, parse_point
+from mission.procs.outputs import check_output_dir, check_output_file
 
 DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
 
@@ -52,12 +53,13 @@ def run(args: argparse.Namespace) -> int:
         from mission.procs.cli_common import die_with_parent
 
         die_with_parent()
+    check_seed(args.seed)
+    speedup = _speedup(args)
     scenario = load_scenario(args.scenario)
     _preflight(scenario)
-    if args.realtime and not 0 < args.speedup <= 1000:
-        raise InputError("command line", "--speedup", "must be in (0, 1000]")
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
+    check_output_dir(out, "--out")
     if args.signing_key is not None:
         from mission.link.signing import read_signing_key
 
@@ -75,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
         args.method,
         args.seed,
         out,
-        args.speedup if args.realtime else None,
+        speedup,
         args.signing_key.resolve() if args.signing_key else None,
         args.observer,
         link,
@@ -90,6 +92,18 @@ def run(args: argparse.Namespace) -> int:
         return 1
     print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
     return 0
+
+
+def _speedup(args: argparse.Namespace) -> float | None:
+    """The real-time speed-up (None: lockstep); --speedup only with --realtime."""
+    if not args.realtime:
+        if args.speedup is not None:
+            raise InputError("command line", "--speedup", "is for --realtime runs (add --realtime)")
+        return None
+    speedup = 1.0 if args.speedup is None else args.speedup
+    if not 0 < speedup <= 1000:
+        raise InputError("command line", "--speedup", f"must be in (0, 1000], got {speedup:g}")
+    return speedup
 
 
 def run_line(summary: dict, timeout_s: float) -> str:
@@ -120,6 +134,7 @@ def batch(args: argparse.Namespace) -> int:
         raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
     if not 1 <= args.jobs <= 64:
         raise InputError("command line", "--jobs", f"must be in [1, 64], got {args.jobs}")
+    check_output_dir(args.out, "--out")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods or any(m not in ("ac", "nac") for m in methods):
         raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
@@ -209,6 +224,7 @@ def plan_directory(out: Path | None, scenario) -> Path:
         out = (Path.cwd() if inside else source.parent) / f"{scenario.name}-plan"
     if out.resolve().is_relative_to(package):
         raise InputError("command line", "--out", f"{out} is inside the installed package")
+    check_output_dir(out, "--out")
     return out
 
 
@@ -220,13 +236,17 @@ def analyze(args: argparse.Namespace) -> int:
     tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
     if not tlog.is_file():
         raise InputError(str(args.run), "", "no gcs.tlog here (give a run directory or a tlog)")
+    if tlog.stat().st_size == 0:
+        raise InputError(str(tlog), "", "is empty")
     summary_path = tlog.parent / "summary.json"
-    previous = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
+    previous = _previous_summary(summary_path)
     scenario_name = args.scenario or previous.get("scenario_source") or previous.get("scenario")
     if scenario_name is None:
         raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
     scenario = load_scenario(scenario_name)
     metrics = analyze_tlog(tlog, scenario)
+    if not metrics["control_cycles"]:
+        raise InputError(str(tlog), "", "holds no control cycle of a ground station")
     merged = {**previous, **metrics}
     if previous:
         from mission.procs.atomic import write_text_atomically
@@ -244,6 +264,20 @@ def analyze(args: argparse.Namespace) -> int:
     return 0
 
 
+def _previous_summary(path: Path) -> dict:
+    """The summary.json beside a tlog ({} if there is none); one line naming it if it is not
+    a JSON object."""
+    if not path.is_file():
+        return {}
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, OSError) as error:
+        raise InputError(str(path), "", f"not a readable JSON summary ({error})") from None
+    if not isinstance(summary, dict):
+        raise InputError(str(path), "", "not a JSON object")
+    return summary
+
+
 def bench(args: argparse.Namespace) -> int:
     """``mission bench``."""
     from mission.runs.bench import format_table, run_benchmarks
@@ -257,7 +291,4 @@ def bench(args: argparse.Namespace) -> int:
 
 
 def _check_output_path(path: Path, flag: str, suffix: str) -> None:
-    if path.suffix.lower() != suffix:
-        raise InputError("command line", flag, f"{path}: the file name must end in {suffix}")
-    if not path.parent.resolve().is_dir():
-        raise InputError("command line", flag, f"{path}: directory {path.parent} does not exist")
+    check_output_file(path, flag, (suffix,))

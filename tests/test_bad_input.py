@@ -3,11 +3,13 @@ and the problem, exit status 2, and leaves no output behind."""
 
 from __future__ import annotations
 
+import socket
 from pathlib import Path
 
 import pytest
 
 import ground_station.cli as gcs_cli
+import mission
 import mission.cli as mission_cli
 import vehicle_sim.cli as vehicle_cli
 from mission.config.scenario import load_scenario
@@ -156,6 +158,77 @@ CASES = [
         lambda t: ["--vehicle", "work", "--socket-fd", "3", "--port", "14560"],
         ["--socket-fd", "--port"],
     ),
+    # --- output locations ----------------------------------------------------------------
+    ("run-out-is-file", lambda t: [*RUN, "--out", str(_file(t))], ["--out", "is a file"]),
+    ("run-out-under-file", lambda t: [*RUN, "--out", str(_file(t) / "a")], ["--out", "under"]),
+    ("run-out-unwritable", lambda t: [*RUN, "--out", "/proc/1/run"], ["--out", "cannot write"]),
+    ("batch-out-is-file", lambda t: ["batch", "--out", str(_file(t))], ["--out", "is a file"]),
+    ("plan-out-is-file", lambda t: ["plan", "--out", str(_file(t))], ["--out", "is a file"]),
+    ("plan-out-package", lambda t: ["plan", "--out", str(SHIPPED_PLAN)], ["--out", "package"]),
+    ("plan-plot-no-dir", lambda t: ["plan", "--plot", str(t / "x" / "p.png")], ["--plot"]),
+    ("world-plot-is-dir", lambda t: ["world", "--plot", str(_dir(t, "w.png"))], ["--plot"]),
+    ("gcs-out-is-file", lambda t: ["--out", str(_file(t))], ["--out", "is a file"]),
+    ("gcs-tlog-no-dir", lambda t: ["--tlog", str(t / "x" / "g.tlog")], ["--tlog", "no directory"]),
+    # --- numbers out of range ------------------------------------------------------------
+    ("run-seed", lambda t: [*RUN, "--seed", "-1"], ["--seed", "negative"]),
+    ("run-speedup-lockstep", lambda t: [*RUN, "--speedup", "0"], ["--speedup", "--realtime"]),
+    ("run-speedup-high", lambda t: [*RUN, "--realtime", "--speedup", "5000"], ["--speedup"]),
+    ("gcs-seed", lambda t: ["--seed", "-3"], ["--seed", "negative"]),
+    ("gcs-base-port", lambda t: ["--base-port", "70000"], ["--base-port", "65535"]),
+    ("gcs-base-port-top", lambda t: ["--base-port", "65534"], ["--base-port", "65537"]),
+    ("vehicle-seed", lambda t: ["--vehicle", "work", "--seed", "-1"], ["--seed"]),
+    (
+        "vehicle-home-inside",
+        lambda t: ["--vehicle", "work", "--home", "0", "0", "8.5"],
+        ["--home", "inside the structure"],
+    ),
+    (
+        "vehicle-home-outside",
+        lambda t: ["--vehicle", "work", "--home", "0", "0", "50"],
+        ["--home", "outside the workspace"],
+    ),
+    # --- the flag at fault named ---------------------------------------------------------
+    (
+        "vehicle-host-unknown",
+        lambda t: ["--vehicle", "support-1", "--port", "0", "--host", "nosuchhost.invalid"],
+        ["--host"],
+    ),
+    (
+        "vehicle-host-not-ours",
+        lambda t: ["--vehicle", "support-1", "--port", "0", "--host", "192.0.2.1"],
+        ["--host", "not this machine"],
+    ),
+    (
+        "vehicle-port-busy",
+        lambda t: ["--vehicle", "support-1", "--port", str(_busy_port())],
+        ["--port", "cannot listen"],
+    ),
+    (
+        "vehicle-truth-port-busy",
+        lambda t: ["--vehicle", "support-1", "--port", "0", "--truth-port", str(_busy_port())],
+        ["--truth-port", "cannot listen"],
+    ),
+    # --- mission analyze ---------------------------------------------------------------------
+    (
+        "analyze-empty-tlog",
+        lambda t: ["analyze", str(_tlog(t, b"")), "--scenario", "along"],
+        ["gcs.tlog", "empty"],
+    ),
+    (
+        "analyze-random-tlog",
+        lambda t: ["analyze", str(_tlog(t, bytes(range(256)) * 40)), "--scenario", "along"],
+        ["gcs.tlog", "no control cycle"],
+    ),
+    (
+        "analyze-bad-summary",
+        lambda t: ["analyze", str(_tlog(t, b"x", summary="{not json"))],
+        ["summary.json", "JSON"],
+    ),
+    (
+        "analyze-summary-list",
+        lambda t: ["analyze", str(_tlog(t, b"x", summary="[1, 2]"))],
+        ["summary.json", "not a JSON object"],
+    ),
     # --- signing keys ------------------------------------------------------------------
     ("key-missing", lambda t: [*RUN, "--signing-key", str(t / "none.key")], ["none.key"]),
     (
@@ -192,6 +265,37 @@ def _wpl(tmp: Path, content: str) -> list[str]:
     return [*RUN, str(_scenario(tmp, f"task: {{waypoints_dir: {plan.name}}}\n"))]
 
 
+SHIPPED_PLAN = Path(mission.__file__).resolve().parent / "scenarios" / "plans" / "bridge"
+_HELD_SOCKETS: list[socket.socket] = []  # busy ports stay busy until the session ends
+
+
+def _file(tmp: Path) -> Path:
+    path = tmp / "a-file"
+    path.write_text("x")
+    return path
+
+
+def _dir(tmp: Path, name: str) -> Path:
+    path = tmp / name
+    path.mkdir()
+    return path
+
+
+def _busy_port() -> int:
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    _HELD_SOCKETS.append(sock)
+    return sock.getsockname()[1]
+
+
+def _tlog(tmp: Path, content: bytes, summary: str | None = None) -> Path:
+    run = _dir(tmp, "run")
+    (run / "gcs.tlog").write_bytes(content)
+    if summary is not None:
+        (run / "summary.json").write_text(summary)
+    return run if summary is not None else run / "gcs.tlog"
+
+
 def _entry(case: str):
     if case.startswith(("gcs-", "wpl-gcs")):
         return gcs_cli.entry_point
@@ -201,9 +305,9 @@ def _entry(case: str):
 
 
 def test_the_table_covers_every_kind_of_input():
-    assert len(CASES) >= 25
+    assert len(CASES) >= 60
     kinds = {c[0].split("-")[0] for c in CASES}
-    assert {"yaml", "wpl", "mesh", "run", "key"} <= kinds
+    assert {"yaml", "wpl", "mesh", "run", "key", "gcs", "vehicle", "analyze", "plan"} <= kinds
 
 
 @pytest.mark.parametrize(("case", "argv", "expected"), CASES, ids=[c[0] for c in CASES])

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
 import socket
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,6 +21,8 @@ from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
 from mission.procs.cli_common import (
     OneLineArgumentParser,
+    check_port,
+    check_seed,
     freeze_startup_heap,
     name_this_process,
     parse_point,
@@ -111,12 +115,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     identity = _identity(args.vehicle)
     name_this_process(f"vsim-{identity.name}")  # forked by `mission run`, it has no own argv
+    check_seed(args.seed)
     if args.speedup is not None and not (0 < args.speedup <= 1000):
         raise InputError("command line", "--speedup", "must be in (0, 1000]")
     if args.socket_fd is not None and args.port is not None:
         raise InputError("command line", "--socket-fd", "cannot be combined with --port")
     port = args.port if args.port is not None else identity.default_port()
-    _check_port(port, "--port", allow_any=True)
+    check_port(port, "--port", allow_any=True)
     outs = [_address(text, "--out") for text in args.out]
     key = read_signing_key(args.signing_key) if args.signing_key is not None else None
     link = link_settings(args)
@@ -124,6 +129,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     scenario = world.scenario
     if args.home:
         home = np.array(parse_point(args.home, "--home"))
+        _check_home(world, home)
     else:
         home = read_vehicle_waypoints(scenario, identity.name)[0]
     clock = ClockSettings(lockstep=args.speedup is None, speedup=args.speedup or 1.0)
@@ -183,28 +189,43 @@ def _open_channels(
         else:
             destinations = [_address(text, "--truth-out") for text in args.truth_out]
         truth_sender = TruthSender(identity.system_id, destinations)
-    try:
+    sock = _inherited_socket(args.socket_fd, "--socket-fd")
+    with _bind_error("--port", args.host, port, defaulted=args.port is None):
         endpoint = UdpEndpoint(
             MavlinkCodec(identity.system_id, 1, key),
             (args.host, port),
             link,
             link_seed=args.seed * 1000 + identity.system_id,
-            sock=_inherited_socket(args.socket_fd, "--socket-fd"),
+            sock=sock,
         )
-        channels = Channels(endpoint, truth_sender)
-        if not identity.is_work:
-            truth_port = args.truth_port
-            if truth_port is None:
-                truth_port = port + TRUTH_PORT_OFFSET if port else 0
-            _check_port(truth_port, "--truth-port", allow_any=True)
-            channels.truth_receiver = TruthReceiver(
-                truth_port,
-                args.host,
-                sock=_inherited_socket(args.truth_socket_fd, "--truth-socket-fd"),
-            )
-    except OSError as error:
-        raise InputError("command line", "--port", f"cannot listen: {error.strerror}") from None
+    channels = Channels(endpoint, truth_sender)
+    if not identity.is_work:
+        truth_port = args.truth_port
+        if truth_port is None:
+            truth_port = port + TRUTH_PORT_OFFSET if port else 0
+        check_port(truth_port, "--truth-port", allow_any=True)
+        sock = _inherited_socket(args.truth_socket_fd, "--truth-socket-fd")
+        defaulted = args.truth_port is None
+        with _bind_error("--truth-port", args.host, truth_port, defaulted=defaulted):
+            channels.truth_receiver = TruthReceiver(truth_port, args.host, sock=sock)
     return channels
+
+
+@contextlib.contextmanager
+def _bind_error(flag: str, host: str, port: int, defaulted: bool) -> Iterator[None]:
+    """A socket that cannot bind as one line naming the flag at fault: --host for an address
+    that is not this machine's, else the port's flag (busy, or not allowed)."""
+    try:
+        yield
+    except socket.gaierror:
+        raise InputError("command line", "--host", f"{host!r} is not an address") from None
+    except OSError as error:
+        if error.errno == errno.EADDRNOTAVAIL:
+            raise InputError("command line", "--host", f"{host!r} is not this machine's") from None
+        what = f"port {port} (the default)" if defaulted else f"port {port}"
+        raise InputError(
+            "command line", flag, f"cannot listen on {what}: {error.strerror}"
+        ) from None
 
 
 def _print_banner(vehicle: Vehicle, channels: Channels, clock: ClockSettings) -> None:
@@ -221,6 +242,14 @@ def _print_banner(vehicle: Vehicle, channels: Channels, clock: ClockSettings) ->
         file=sys.stderr,
         flush=True,
     )
+
+
+def _check_home(world: World, home: np.ndarray) -> None:
+    """A start position inside the workspace and outside the structure."""
+    if not world.in_workspace(home[None])[0]:
+        raise InputError("command line", "--home", f"{home.tolist()} is outside the workspace")
+    if world.structure.contains(home[None])[0]:
+        raise InputError("command line", "--home", f"{home.tolist()} is inside the structure")
 
 
 def _inherited_socket(fd: int | None, flag: str) -> socket.socket | None:
@@ -253,12 +282,6 @@ def _address(text: str, flag: str):
         return parse_address(text, flag)
     except ValueError as error:
         raise InputError("command line", flag, str(error)) from None
-
-
-def _check_port(port: int, flag: str, allow_any: bool = False) -> None:
-    lowest = 0 if allow_any else 1
-    if not lowest <= port < 65536:
-        raise InputError("command line", flag, f"port must be in {lowest}..65535, got {port}")
 
 
 def entry_point(argv: Sequence[str] | None = None) -> int:

@@ -59,6 +59,19 @@ def parse_point(values: Sequence[float], flag: str) -> tuple[float, float, float
     return float(values[0]), float(values[1]), float(values[2])
 
 
+def check_seed(seed: int, flag: str = "--seed") -> None:
+    """A seed is a non-negative integer (numpy's generators refuse others)."""
+    if seed < 0:
+        raise InputError("command line", flag, f"must not be negative, got {seed}")
+
+
+def check_port(port: int, flag: str, allow_any: bool = False) -> None:
+    """A UDP port: 1..65535 (0, any free port, where ``allow_any``)."""
+    lowest = 0 if allow_any else 1
+    if not lowest <= port < 65536:
+        raise InputError("command line", flag, f"port must be in {lowest}..65535, got {port}")
+
+
 PARENT_PID_VARIABLE = "MISSION_PARENT_PID"
 
 

@@ -64,7 +64,7 @@ def test_summary_and_plot(tmp_path, capsys):
     [
         (["world", "nosuch"], "no such scenario"),
         (["world", "along", "--at", "0", "nan", "1"], "--at"),
-        (["world", "along", "--plot", "/nonexistent/dir/w.png"], "does not exist"),
+        (["world", "along", "--plot", "/nonexistent/dir/w.png"], "no directory"),
         (["world", "along", "--plot", "w.jpg"], "must end in .png"),
         (["world", "along", "--at", "1", "2"], "expected 3 argument"),
     ],

@@ -1,0 +1,48 @@
+"""Output locations checked before anything is started or written: a directory a run may
+create, or a file it may write, named by a flag. Nothing here creates anything."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from mission.config.errors import InputError
+
+
+def check_output_dir(path: Path, flag: str) -> None:
+    """``path`` can be a directory this process makes (or fills): it is not a file, it lies
+    under no file, and its nearest existing ancestor is a directory we may write in."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError("command line", flag, f"{str(path)!r} is a file, not a directory")
+    _check_writable_ancestor(path, flag)
+
+
+def check_output_file(path: Path, flag: str, suffixes: tuple[str, ...] = ()) -> None:
+    """``path`` can be a file this process writes: the right suffix, not a directory, in an
+    existing directory we may write in."""
+    path = Path(path)
+    if suffixes and path.suffix.lower() not in suffixes:
+        wanted = " or ".join(suffixes)
+        raise InputError("command line", flag, f"{str(path)!r}: the file name must end in {wanted}")
+    if path.is_dir():
+        raise InputError("command line", flag, f"{str(path)!r} is a directory, not a file")
+    parent = path.parent
+    if not parent.is_dir():
+        raise InputError("command line", flag, f"{str(path)!r}: no directory {str(parent)!r}")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError("command line", flag, f"{str(path)!r}: cannot write in {str(parent)!r}")
+
+
+def _check_writable_ancestor(path: Path, flag: str) -> None:
+    ancestor = path
+    while not ancestor.exists():
+        if ancestor.parent == ancestor:
+            break
+        ancestor = ancestor.parent
+    if ancestor.exists() and not ancestor.is_dir():
+        raise InputError(
+            "command line", flag, f"{str(path)!r} lies under the file {str(ancestor)!r}"
+        )
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise InputError("command line", flag, f"{str(path)!r}: cannot write in {str(ancestor)!r}")
