@@ -13,6 +13,7 @@ from pathlib import Path
 from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.link.mavlink_udp import parse_address
+from mission.link.plan_check import check_plan_files
 from mission.link.plan_files import vehicle_names
 from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
@@ -94,15 +95,6 @@ def build_parser() -> OneLineArgumentParser:
     return parser
 
 
-def read_waypoints_file(path: Path) -> None:
-    """Check one vehicle's waypoint file (InputError naming the file and line)."""
-    from mission.link.waypoints import read_waypoints
-
-    if not path.is_file():
-        raise InputError(str(path), "", "no such waypoint file")
-    read_waypoints(path)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a mission and print its summary as JSON."""
     from ground_station.links import StationError
@@ -125,8 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     waypoints = args.waypoints or Path(scenario.task.waypoints_dir)
     if not waypoints.is_dir():
         raise InputError("command line", "--waypoints", f"{waypoints} is not a directory")
-    for name in vehicles:  # every waypoint file is checked before anything is started
-        read_waypoints_file(waypoints / f"{name}.waypoints")
+    check_plan_files(world, waypoints, list(vehicles))  # before anything is started
     out = args.out or Path("logs") / f"gcs-{time.strftime('%Y%m%d-%H%M%S')}"
     check_output_dir(out, "--out")
     if args.tlog is not None:

@@ -165,14 +165,15 @@ def batch(args: argparse.Namespace) -> int:
 
 
 def _preflight(scenario) -> None:
-    """Everything a run reads from files, checked before any process starts."""
-    from mission.link.plan_files import read_plan
-    from mission.world.structure import load_mesh_file
+    """Everything a run reads from files, checked before any process starts: the structure's
+    mesh (loading the known world) and every vehicle's waypoint file."""
+    from mission.link.plan_check import check_plan_files
+    from mission.link.plan_files import vehicle_names
+    from mission.world.model import KnownWorld
 
-    mesh_file = scenario.world.structure.mesh_file
-    if mesh_file is not None:
-        load_mesh_file(Path(mesh_file), scenario.source)
-    read_plan(scenario)  # every vehicle's waypoint file
+    world = KnownWorld(scenario)
+    names = vehicle_names(scenario.task.supports)
+    check_plan_files(world, Path(scenario.task.waypoints_dir), names)
 
 
 def plan(args: argparse.Namespace) -> int:

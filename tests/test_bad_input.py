@@ -42,6 +42,13 @@ def _key(tmp: Path, content: bytes) -> Path:
 
 
 RUN = ["run"]
+FAR_BOX = (
+    "world: {structure: {primitives: [{name: x, min_m: [0, 0, 0], max_m: [1.0e+30, 1, 1]}]}}\n"
+)
+TWO_ZONES = (
+    "world: {{zones: [{{name: {name}, min_m: [0, 0, 1], max_m: [1, 1, 2], offset_m: [1, 0, 0]}},"
+    " {{name: {name}, min_m: [2, 0, 1], max_m: [3, 1, 2], offset_m: [1, 0, 0]}}]}}\n"
+)
 CASES = [
     # --- scenario YAML -----------------------------------------------------------------
     (
@@ -111,6 +118,31 @@ CASES = [
         ["flat.obj"],
     ),
     (
+        "mesh-far-away",
+        lambda t: [*RUN, str(_mesh(t, b"v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n", "far.obj"))],
+        ["far.obj", "from the anchor"],
+    ),
+    (
+        "yaml-box-far-away",
+        lambda t: [*RUN, str(_scenario(t, FAR_BOX))],
+        ["bad.yaml", "world.structure.primitives[0].max_m", "at most"],
+    ),
+    (
+        "yaml-zone-name-newline",
+        lambda t: [*RUN, str(_scenario(t, TWO_ZONES.format(name='"a\\nb"')))],
+        ["bad.yaml", "duplicate zone name", "a\\nb"],
+    ),
+    (
+        "yaml-key-newline",
+        lambda t: [*RUN, str(_scenario(t, '"con\\ntrol": {}\n'))],
+        ["bad.yaml", "con\\ntrol", "unknown key"],
+    ),
+    (
+        "scenario-file-newline",
+        lambda t: [*RUN, str(t / "bad\nname.yaml")],
+        ["bad\\nname.yaml", "no such scenario file"],
+    ),
+    (
         "plan-dir-missing",
         lambda t: [*RUN, str(_scenario(t, "task: {waypoints_dir: nowhere}\n"))],
         ["nowhere"],
@@ -132,6 +164,17 @@ CASES = [
         "wpl-latitude",
         lambda t: _wpl(t, HEADER + "\n" + GOOD_ROW.replace("35.15", "135.15")),
         ["work.waypoints", "line 2"],
+    ),
+    ("wpl-home-only", lambda t: _wpl(t, _rows()), ["work.waypoints", "at least one waypoint"]),
+    ("wpl-unequal", lambda t: _wpl(t, _rows(7.0)), ["support-1.waypoints", "pair by index"]),
+    ("wpl-frame", lambda t: _wpl(t, _rows(7.0, frame=1)), ["work.waypoints", "item 1", "frame"]),
+    ("wpl-command", lambda t: _wpl(t, _rows(7.0, command=178)), ["item 1", "command 178"]),
+    ("wpl-in-deck", lambda t: _wpl(t, _rows(8.5)), ["work.waypoints", "inside the structure"]),
+    ("wpl-too-high", lambda t: _wpl(t, _rows(50.0)), ["work.waypoints", "outside the workspace"]),
+    (
+        "wpl-gcs-in-deck",
+        lambda t: ["--waypoints", str(_plan_dir(t, "support-3", _rows(8.5)))],
+        ["support-3.waypoints", "inside the structure"],
     ),
     (
         "wpl-gcs-file",
@@ -267,6 +310,14 @@ def _wpl(tmp: Path, content: str) -> list[str]:
 
 SHIPPED_PLAN = Path(mission.__file__).resolve().parent / "scenarios" / "plans" / "bridge"
 _HELD_SOCKETS: list[socket.socket] = []  # busy ports stay busy until the session ends
+
+
+def _rows(*altitudes: float, frame: int = 3, command: int = 16) -> str:
+    """A waypoint file: home at the anchor, 7 m up, then one row per altitude there."""
+    rows = [GOOD_ROW]
+    for seq, altitude in enumerate(altitudes, start=1):
+        rows.append(f"{seq}\t0\t{frame}\t{command}\t0\t0.1\t0\t0\t35.15\t136.96\t{altitude}\t1\n")
+    return HEADER + "\n" + "".join(rows)
 
 
 def _file(tmp: Path) -> Path:

@@ -11,7 +11,13 @@ class InputError(Exception):
         self.where = where
         self.problem = problem
         location = f"{source}: {where}" if where else source
-        super().__init__(f"{location}: {problem}")
+        super().__init__(one_line(f"{location}: {problem}"))
+
+
+def one_line(text: str) -> str:
+    """``text`` with every character that would break or hide a line (a newline, a tab, a
+    control character) written as its escape: a name holding one cannot split an error."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 class ScenarioError(InputError):

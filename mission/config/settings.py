@@ -14,6 +14,7 @@ from typing import Literal
 from mission.config.errors import FieldProblem
 
 Vec3 = tuple[float, float, float]
+MAX_COORDINATE_M = 100_000.0  # a world-frame coordinate beyond this is not a site's metres
 
 
 def _require(condition: bool, field: str, problem: str) -> None:
@@ -40,6 +41,12 @@ class Box:
     max_m: Vec3
 
     def __post_init__(self) -> None:
+        for corner, name in ((self.min_m, "min_m"), (self.max_m, "max_m")):
+            _require(
+                all(abs(v) <= MAX_COORDINATE_M for v in corner),
+                name,
+                f"coordinates are metres from the anchor, at most {MAX_COORDINATE_M:g}: {corner}",
+            )
         for axis in range(3):
             _require(
                 self.min_m[axis] < self.max_m[axis],

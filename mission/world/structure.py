@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mission.config.errors import ScenarioError
-from mission.config.settings import BoxPrimitive, StructureSettings
+from mission.config.settings import MAX_COORDINATE_M, BoxPrimitive, StructureSettings
 from mission.world.rays import best_ray_engine
 
 if TYPE_CHECKING:
@@ -129,7 +129,8 @@ def load_mesh_file(path: Path, source: str = "") -> trimesh.Trimesh:
     if path.suffix.lower() not in _MESH_SUFFIXES:
         raise ScenarioError(source or str(path), where, f"{path}: not an STL, OBJ or PLY file")
     try:
-        loaded = trimesh.load(str(path), force="mesh", process=True)
+        with np.errstate(all="ignore"):  # absurd coordinates are reported below
+            loaded = trimesh.load(str(path), force="mesh", process=True)
     except Exception as error:  # trimesh raises many types for malformed files
         raise ScenarioError(
             source or str(path), where, f"{path}: cannot read mesh ({type(error).__name__})"
@@ -138,6 +139,10 @@ def load_mesh_file(path: Path, source: str = "") -> trimesh.Trimesh:
         raise ScenarioError(source or str(path), where, f"{path}: holds no triangles")
     if not np.all(np.isfinite(loaded.vertices)):
         raise ScenarioError(source or str(path), where, f"{path}: has non-finite vertices")
+    farthest = float(np.abs(loaded.vertices).max())
+    if farthest > MAX_COORDINATE_M:
+        problem = f"{path}: a vertex lies {farthest:.3g} m from the anchor (metres, ENU expected)"
+        raise ScenarioError(source or str(path), where, problem)
     return loaded
 
 

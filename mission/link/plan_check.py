@@ -1,0 +1,54 @@
+"""A scenario's waypoint files checked as the vehicles and the ground station will use them,
+before any process starts: what a vehicle would refuse, or fly into, is caught here."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from mission.config.errors import InputError
+from mission.link.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
+from mission.link.waypoints import WaypointRow, read_waypoints, row_position_enu
+from mission.world.frames import GeodeticFrame
+from mission.world.model import KnownWorld
+
+
+def check_plan_files(world: KnownWorld, directory: Path, names: Sequence[str]) -> None:
+    """Each vehicle's ``<name>.waypoints`` in ``directory``: home and at least one waypoint,
+    every row a navigation command in a global frame, every position inside the workspace and
+    outside the structure; every support with as many waypoints as the work UAV (they pair by
+    index). The first problem raises InputError naming the file and the item."""
+    frame = GeodeticFrame(world.scenario.world.anchor)
+    counts = {}
+    for name in names:
+        path = Path(directory) / f"{name}.waypoints"
+        if not path.is_file():
+            raise InputError(str(path), "", f"no waypoint file for {name}")
+        rows = read_waypoints(path)
+        if len(rows) < 2:
+            raise InputError(str(path), "", "needs a home row and at least one waypoint")
+        for row in rows:
+            _check_row(world, frame, path, row)
+        counts[name] = len(rows) - 1
+    work = counts.get("work")
+    for name, count in counts.items():
+        if work is not None and count != work:
+            path = Path(directory) / f"{name}.waypoints"
+            problem = f"{count} waypoints, but work.waypoints has {work} (they pair by index)"
+            raise InputError(str(path), "", problem)
+
+
+def _check_row(world: KnownWorld, frame: GeodeticFrame, path: Path, row: WaypointRow) -> None:
+    where = f"item {row.seq}"
+    if row.command not in NAV_POSITION_COMMANDS:
+        raise InputError(str(path), where, f"command {row.command} is not a waypoint to fly")
+    if row.frame not in GLOBAL_FRAMES:
+        raise InputError(str(path), where, f"frame {row.frame} is not a global frame")
+    position = np.asarray(row_position_enu(row, frame))
+    shown = [round(float(v), 2) for v in position]
+    if not world.in_workspace(position[None])[0]:
+        raise InputError(str(path), where, f"{shown} (ENU) lies outside the workspace")
+    if world.structure.contains(position[None])[0]:
+        raise InputError(str(path), where, f"{shown} (ENU) lies inside the structure")
