@@ -17,6 +17,7 @@ from mission.link.plan_check import check_plan_files
 from mission.link.plan_files import vehicle_names
 from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
+from mission.procs.atomic import write_text_atomically
 from mission.procs.cli_common import (
     OneLineArgumentParser,
     check_port,
@@ -144,9 +145,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     finally:
         station.close()
-    print(
-        json.dumps({"scenario": scenario.name, "method": args.method, "seed": args.seed, **summary})
-    )
+    who = {"scenario": scenario.name, "scenario_source": scenario.source}
+    summary = {**who, "method": args.method, "seed": args.seed, **summary}
+    summary["link"] = json.loads((out / "link.json").read_text())
+    write_text_atomically(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+    print(json.dumps(summary))
     return 0
 
 

@@ -13,7 +13,9 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,6 +64,8 @@ def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> li
             missing[index] = library_name
     if not missing:
         return libraries
+    started = time.monotonic()
+    _say(f"{COMPILING} with {Path(compiler).name}: once per machine, cached in {_cache_dir()}")
     with tempfile.TemporaryDirectory(prefix="support-mpc-c-") as scratch:
         sources: dict[int, tuple[str, Path]] = {}
         for index, library_name in missing.items():
@@ -82,7 +86,16 @@ def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> li
             for index, library in _compile_all(compiler, sources, directory).items():
                 libraries[index] = library
                 del sources[index]
+    _say(f"{COMPILED} in {time.monotonic() - started:.1f} s")
     return libraries
+
+
+COMPILING = "compiling the support MPC"  # what `mission run` shows of a first run's wait
+COMPILED = "compiled the support MPC"
+
+
+def _say(text: str) -> None:
+    print(f"ground station: {text}", file=sys.stderr, flush=True)
 
 
 def c_compiler() -> str | None:

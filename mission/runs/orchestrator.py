@@ -33,6 +33,9 @@ from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
 SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
+# what the ground station says of a first run's compilation (ground_station.nlp_cache's
+# COMPILING and COMPILED, written out here: importing it would import casadi)
+COMPILE_NEWS = ("compiling the support MPC", "compiled the support MPC")
 
 
 class RunFailed(RuntimeError):
@@ -225,13 +228,16 @@ def _launch(
 
 def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
     """Wait for the ground station; a dead required vehicle, or one that never started,
-    ends the run with an error."""
+    ends the run with an error. What the ground station says of a first run's compilation is
+    shown as it comes."""
+    relay = LogRelay(gcs.log, COMPILE_NEWS)
     while True:
         try:
             gcs.process.wait(timeout=SUPERVISE_S)
+            relay.poll()
             return
         except subprocess.TimeoutExpired:
-            pass
+            relay.poll()
         for child in children:
             if child is gcs or child.process.poll() is None:
                 continue
@@ -242,6 +248,35 @@ def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
                 raise RunFailed(
                     f"{child.name} died (exit status {child.process.returncode}, see {child.log})"
                 )
+
+
+class LogRelay:
+    """Shows on this process's stderr, once each, the lines of a child's log that start with
+    one of ``prefixes`` (after the child's ``name: ``), reading only what is new."""
+
+    def __init__(self, log: Path, prefixes: tuple[str, ...]) -> None:
+        self.log = log
+        self.pending = list(prefixes)
+        self._offset = 0
+
+    def poll(self) -> None:
+        """Show what has come since the last poll."""
+        if not self.pending:
+            return
+        try:
+            with self.log.open("rb") as handle:
+                handle.seek(self._offset)
+                data = handle.read()
+        except OSError:
+            return
+        end = data.rfind(b"\n") + 1  # whole lines only
+        self._offset += end
+        for line in data[:end].decode("utf-8", "replace").splitlines():
+            text = line.split(": ", 1)[-1]
+            for prefix in list(self.pending):
+                if text.startswith(prefix):
+                    print(text, file=sys.stderr, flush=True)
+                    self.pending.remove(prefix)
 
 
 def _stop_all(children: list[Child]) -> None:

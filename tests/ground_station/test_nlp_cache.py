@@ -31,6 +31,25 @@ def _compiled_one(name, plugin, nlp, options, fallback_dir):
     return nlp_cache.compiled_nlps([build], fallback_dir)[0]
 
 
+def test_a_compilation_says_so_and_how_long_it_took_and_a_hit_says_nothing(
+    tmp_path, monkeypatch, capsys
+):
+    from ground_station import nlp_cache
+
+    if c_compiler() is None:
+        return
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    nlp, options = _tiny_solver()
+    _compiled_one("tiny", "ipopt", nlp, options, lambda: str(tmp_path))
+    said = capsys.readouterr().err.splitlines()
+    assert said[0] == f"ground station: {nlp_cache.COMPILING} with {Path(c_compiler()).name}: " + (
+        f"once per machine, cached in {tmp_path / 'cache' / 'bridge-uav-formation'}"
+    )
+    assert said[1].startswith(f"ground station: {nlp_cache.COMPILED} in ") and len(said) == 2
+    _compiled_one("tiny", "ipopt", nlp, options, lambda: str(tmp_path))
+    assert capsys.readouterr().err == ""
+
+
 def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypatch):
     import tempfile
 
@@ -48,7 +67,7 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
         raise AssertionError("the cache is writable: no fallback directory")
 
     first = _compiled_one("tiny", "ipopt", nlp, options, no_fallback)
-    if not c_compiler() is not None:
+    if c_compiler() is None:
         assert first is None
         return
     assert first is not None and Path(first).parent == tmp_path / "cache" / "bridge-uav-formation"
@@ -100,7 +119,7 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
 
     from ground_station import nlp_cache
 
-    if not c_compiler() is not None:
+    if c_compiler() is None:
         return
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     nlp, options = _tiny_solver()
@@ -142,7 +161,7 @@ def test_an_unwritable_cache_compiles_into_the_fallback_directory(tmp_path, monk
     fallback = tmp_path / "private"
     nlp, options = _tiny_solver()
     library = _compiled_one("tiny", "ipopt", nlp, options, lambda: str(fallback))
-    if not c_compiler() is not None:
+    if c_compiler() is None:
         assert library is None
         return
     assert library is not None and Path(library).parent == fallback

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from pymavlink import mavutil
 
+import mission.cli as mission_cli
 from mission.config.scenario import load_scenario
 from mission.link.plan_files import write_plan
 from mission.planning.planner import plan_supports
@@ -93,6 +94,13 @@ def test_a_short_mission_completes_and_is_logged(short_scenario, tmp_path):
         summary = _run_station(short_scenario, tmp_path, "ac", vehicles)
     assert summary["completed"] is True
     assert 20 < summary["completion_time_s"] < 120
+    written = json.loads((tmp_path / "summary.json").read_text())  # a by-hand run has one too
+    assert written == summary and written["scenario_source"] == str(short_scenario)
+    assert "multipath_steps" not in written  # truth: the ground station does not know it
+    assert mission_cli.entry_point(["analyze", str(tmp_path)]) == 0  # no --scenario needed
+    analysed = json.loads((tmp_path / "summary.json").read_text())
+    assert analysed["control_cycles"] == summary["control_cycles"]
+    assert set(analysed["multipath_steps"]) == {"support-1", "support-2", "support-3"}
     records = [json.loads(line) for line in (tmp_path / "records.jsonl").read_text().splitlines()]
     assert len(records) == summary["control_cycles"]
     assert records[-1]["k"] == 2 and records[-1]["arrived"] == 2
