@@ -190,7 +190,8 @@ def plan(args: argparse.Namespace) -> int:
     plan = plan_supports(world)
     for path in write_plan(plan, world.scenario, out):
         print(f"wrote {path}")
-    print(f"to fly it: task: {{waypoints_dir: {out.resolve()}}} in the scenario")
+    if out.resolve() != Path(world.scenario.task.waypoints_dir).resolve():
+        print(f"to fly it: task: {{waypoints_dir: {out.resolve()}}} in the scenario")
     try:
         along, segment = place_along(plan, world.workspace)
         print(
@@ -215,14 +216,20 @@ def plan(args: argparse.Namespace) -> int:
 
 
 def plan_directory(out: Path | None, scenario) -> Path:
-    """Where ``mission plan`` writes: ``--out``, else ``<name>-plan/`` beside the user's
-    scenario file, or in the current directory for an embedded scenario. Never inside the
+    """Where ``mission plan`` writes: ``--out``, else the scenario's own ``waypoints_dir``
+    when the scenario sets one outside the package, else ``<name>-plan/`` beside the user's
+    scenario file (in the current directory for an embedded scenario). Never inside the
     installed package (its shipped plans would change every later run)."""
     package = Path(__file__).resolve().parent
     if out is None:
+        planned = Path(scenario.task.waypoints_dir)
         source = Path(scenario.source)
-        inside = source.resolve().is_relative_to(package)
-        out = (Path.cwd() if inside else source.parent) / f"{scenario.name}-plan"
+        if not planned.resolve().is_relative_to(package):
+            out = planned
+        elif source.resolve().is_relative_to(package):
+            out = Path.cwd() / f"{scenario.name}-plan"
+        else:
+            out = source.parent / f"{scenario.name}-plan"
     if out.resolve().is_relative_to(package):
         raise InputError("command line", "--out", f"{out} is inside the installed package")
     check_output_dir(out, "--out")

@@ -31,6 +31,11 @@ def test_a_users_scenario_is_planned_beside_its_file(write_scenario, tmp_path, m
     assert plan_directory(tmp_path / "x", scenario) == tmp_path / "x"
 
 
+def test_a_scenario_that_names_its_plan_is_planned_there(write_scenario):
+    path = write_scenario("extends: along\nname: mine\ntask: {waypoints_dir: flights}\n")
+    assert plan_directory(None, load_scenario(str(path))) == path.parent / "flights"
+
+
 def test_the_package_is_refused_as_an_output(write_scenario):
     scenario = load_scenario(str(write_scenario("extends: along\n")))
     with pytest.raises(InputError, match=r"--out.*inside the installed package"):
