@@ -25,6 +25,7 @@ import numpy as np
 
 from ground_station.los_anchors import LosAnchors
 from ground_station.support_nlp import build_support_nlp
+from mission.config.resources import mpc_window_shape
 from mission.config.settings import ControlSettings
 from mission.world.camera import CameraModel
 from mission.world.grid import VoxelGrid
@@ -89,9 +90,7 @@ class SupportMpc:
             None if sigma0 is None else np.asarray(sigma0, dtype=float).reshape(grid.shape)
         )
         self.horizon = control.horizon_steps
-        reach = control.horizon_steps * control.d_max_support_m + grid.voxel_m
-        half = int(np.ceil(reach / grid.voxel_m))
-        self.window = tuple(min(2 * half + 1, n) for n in grid.shape)
+        self.window = mpc_window_shape(control, grid.voxel_m, grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
         nlp = build_support_nlp(control, self._window_grid, with_prior=sigma0 is not None)
         self._solvers, self._cost = nlp.solvers, nlp.cost

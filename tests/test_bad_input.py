@@ -45,6 +45,9 @@ RUN = ["run"]
 FAR_BOX = (
     "world: {structure: {primitives: [{name: x, min_m: [0, 0, 0], max_m: [1.0e+30, 1, 1]}]}}\n"
 )
+WIDE_WINDOW = "map: {voxel_size_m: 0.5}\ncontrol: {horizon_steps: 25}\n"
+HUGE_WORKSPACE = "world: {workspace: {min_m: [-20000, -20000, 0], max_m: [20000, 20000, 100]}}\n"
+RAISED_LIMIT = "map: {voxel_size_m: 0.01}\nlimits: {max_map_voxels: 100000000000}\n"
 TWO_ZONES = (
     "world: {{zones: [{{name: {name}, min_m: [0, 0, 1], max_m: [1, 1, 2], offset_m: [1, 0, 0]}},"
     " {{name: {name}, min_m: [2, 0, 1], max_m: [3, 1, 2], offset_m: [1, 0, 0]}}]}}\n"
@@ -116,6 +119,45 @@ CASES = [
         "mesh-no-faces",
         lambda t: [*RUN, str(_mesh(t, b"v 0 0 0\nv 1 0 0\n", "flat.obj"))],
         ["flat.obj"],
+    ),
+    # --- what a run would ask of the machine --------------------------------------------------
+    (
+        "yaml-voxel-tiny",
+        lambda t: [*RUN, str(_scenario(t, "map: {voxel_size_m: 0.01}\n"))],
+        ["map.voxel_size_m", "50 x 40 x 20 m", "limits.max_map_voxels"],
+    ),
+    (
+        "yaml-workspace-huge",
+        lambda t: [*RUN, str(_scenario(t, HUGE_WORKSPACE))],
+        ["map.voxel_size_m", "40000 x 40000 x 100 m", "GB"],
+    ),
+    (
+        "yaml-mpc-window",
+        lambda t: [
+            *RUN,
+            str(_scenario(t, "map: {voxel_size_m: 0.5}\ncontrol: {horizon_steps: 25}\n")),
+        ],
+        ["map.voxel_size_m", "limits.max_mpc_window_voxels"],
+    ),
+    (
+        "yaml-particles",
+        lambda t: [*RUN, str(_scenario(t, "fusion: {broad_particles: 1000000}\n"))],
+        ["fusion.broad_particles", "limits.max_particles"],
+    ),
+    (
+        "yaml-horizon",
+        lambda t: [*RUN, str(_scenario(t, "control: {horizon_steps: 500}\n"))],
+        ["control.horizon_steps", "limits.max_horizon_steps"],
+    ),
+    (
+        "yaml-cycles",
+        lambda t: [*RUN, str(_scenario(t, "control: {t_cont_s: 0.0001}\n"))],
+        ["control.t_cont_s", "limits.max_control_cycles"],
+    ),
+    (
+        "yaml-memory",
+        lambda t: [*RUN, str(_scenario(t, RAISED_LIMIT))],
+        ["map.voxel_size_m", "limits.max_memory_fraction", "this machine"],
     ),
     (
         "mesh-far-away",

@@ -15,6 +15,7 @@ from typing import Any
 import yaml
 
 from mission.config.errors import FieldProblem, ScenarioError, read_text_file
+from mission.config.resources import check_resources
 from mission.config.settings import Scenario
 from mission.config.settings_build import build_settings
 
@@ -56,6 +57,7 @@ def load_scenario(name_or_path: str) -> Scenario:
     merged["source"] = str(path)
     try:
         scenario = build_settings(Scenario, merged)
+        check_resources(scenario)
     except FieldProblem as problem:
         raise ScenarioError(str(path), problem.field, problem.problem) from None
     _check_files(scenario, path)

@@ -12,6 +12,7 @@ from datetime import datetime
 from typing import Literal
 
 from mission.config.errors import FieldProblem
+from mission.config.limit_settings import LimitSettings
 
 Vec3 = tuple[float, float, float]
 MAX_COORDINATE_M = 100_000.0  # a world-frame coordinate beyond this is not a site's metres
@@ -388,6 +389,7 @@ class Scenario:
     task: TaskSettings
     planner: PlannerSettings
     vehicle: VehicleSettings
+    limits: LimitSettings
 
     def __post_init__(self) -> None:
         for i, point in enumerate(self.task.work_waypoints_m):
