@@ -53,7 +53,7 @@ def _add_world_parser(commands) -> None:
     world.add_argument(
         "--plot",
         type=Path,
-        metavar="FILE.png",
+        metavar="FILE.png|pdf|svg",
         help="draw structure, zones, sky plot and sigma_0 slices",
     )
 
@@ -73,7 +73,7 @@ def _add_plan_parser(commands) -> None:
         metavar="DIR",
         help="directory for the files (default: the scenario's waypoints_dir)",
     )
-    plan.add_argument("--plot", type=Path, metavar="FILE.png", help="draw the plan")
+    plan.add_argument("--plot", type=Path, metavar="FILE.png|pdf|svg", help="draw the plan")
 
 
 def _add_analyze_parser(commands) -> None:

@@ -25,7 +25,7 @@ def world(args: argparse.Namespace) -> int:
     from mission.world.model import World
 
     if args.plot is not None:
-        _check_output_path(args.plot, "--plot", ".png")
+        _check_output_path(args.plot, "--plot")
     world = World.load(args.scenario)
     if point is not None:
         from mission.analysis.world_report import point_report
@@ -184,7 +184,7 @@ def plan(args: argparse.Namespace) -> int:
     from mission.world.model import World
 
     if args.plot is not None:
-        _check_output_path(args.plot, "--plot", ".png")
+        _check_output_path(args.plot, "--plot")
     world = World.load(args.scenario)
     out = plan_directory(args.out, world.scenario)
     plan = plan_supports(world)
@@ -263,11 +263,13 @@ def analyze(args: argparse.Namespace) -> int:
     print(json.dumps(metrics))
     if args.plots:
         from mission.analysis.metrics import read_tlog
-        from mission.analysis.run_plot import plot_run
+        from mission.analysis.run_plot import RunLabel, plot_run
         from mission.world.model import World
 
         trace = read_tlog(tlog, scenario)
-        for path in plot_run(trace, World(scenario), tlog.parent / "g", tlog.parent / "plots"):
+        label = RunLabel(scenario.name, previous.get("method"), previous.get("seed"))
+        plots = tlog.parent / "plots"
+        for path in plot_run(trace, World(scenario), tlog.parent / "g", plots, label):
             print(f"wrote {path}")
     return 0
 
@@ -298,5 +300,7 @@ def bench(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_output_path(path: Path, flag: str, suffix: str) -> None:
-    check_output_file(path, flag, (suffix,))
+def _check_output_path(path: Path, flag: str) -> None:
+    from mission.analysis.figures import FIGURE_SUFFIXES
+
+    check_output_file(path, flag, FIGURE_SUFFIXES)

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -21,24 +22,45 @@ import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+from mission.analysis.figures import save_figure
 from mission.analysis.metrics import RunTrace, work_errors, zone_steps
 from mission.analysis.world_plot import draw_background
-from mission.procs.atomic import write_atomically
 from mission.world.model import Sigma0Map, World
 
 COLORS = {1: "tab:red", 2: "tab:blue", 3: "tab:green", 4: "tab:purple", 5: "tab:olive"}
 AXES = "xyz"
 
 
-def plot_run(trace: RunTrace, world: World, g_dir: Path, out_dir: Path) -> list[Path]:
+@dataclass(frozen=True)
+class RunLabel:
+    """Which run a figure shows: every title says it."""
+
+    scenario: str
+    method: str | None  # "ac", "nac", or None when unknown
+    seed: int | None
+
+    def __str__(self) -> str:
+        method = (self.method or "method unknown").upper()
+        seed = "seed unknown" if self.seed is None else f"seed {self.seed}"
+        return f"{self.scenario}, {method}, {seed}"
+
+    @property
+    def learns(self) -> bool:
+        """False for NAC, the baseline that never updates G."""
+        return self.method != "nac"
+
+
+def plot_run(
+    trace: RunTrace, world: World, g_dir: Path, out_dir: Path, label: RunLabel
+) -> list[Path]:
     """Write the three figures into ``out_dir``; return their paths."""
     out_dir.mkdir(parents=True, exist_ok=True)
     sigma0 = world.sigma0_map()
     initial, final = _snapshots(g_dir, sigma0)
     paths = [out_dir / "trajectories.png", out_dir / "error.png", out_dir / "g_update.png"]
-    _trajectories(trace, world, dataclasses.replace(sigma0, sigma_m=final), paths[0])
-    _error(trace, world, paths[1])
-    _g_update(world, sigma0, initial, final, paths[2])
+    _trajectories(trace, world, dataclasses.replace(sigma0, sigma_m=final), paths[0], label)
+    _error(trace, world, paths[1], label)
+    _g_update(world, sigma0, initial, final, paths[2], label)
     return paths
 
 
@@ -67,7 +89,9 @@ def _label(system: int) -> str:
     return "work UAV" if system == 1 else f"support {system - 1}"
 
 
-def _trajectories(trace: RunTrace, world: World, g_map: Sigma0Map, path: Path) -> None:
+def _trajectories(
+    trace: RunTrace, world: World, g_map: Sigma0Map, path: Path, label: RunLabel
+) -> None:
     fig = plt.figure(figsize=(15, 11))
     ax3d = fig.add_subplot(2, 2, 1, projection="3d")
     ax3d.add_collection3d(
@@ -98,17 +122,19 @@ def _trajectories(trace: RunTrace, world: World, g_map: Sigma0Map, path: Path) -
         ax.set_xlabel(f"{AXES[a]} [m]")
         ax.set_ylabel(f"{AXES[b]} [m]")
         centre = g_map.grid.axis_centers(normal)[k]
-        ax.set_title(f"{title}; final G at {AXES[normal]} = {centre:g} m")
+        shown = "final G" if label.learns else "sigma_0 (G not learned, NAC)"
+        ax.set_title(f"{title}; {shown} at {AXES[normal]} = {centre:g} m")
         ax.set_aspect("equal")
     ax = fig.add_subplot(2, 2, 4)
     ax.axis("off")
     ax.text(0, 0.5, _legend_text(trace), family="monospace", fontsize=10, va="center")
-    fig.suptitle(f"scenario '{world.scenario.name}': trajectories, zones and the final G")
+    background = "the final G" if label.learns else "sigma_0: G not learned (NAC)"
+    fig.suptitle(f"{label}: trajectories, zones and {background}")
     fig.tight_layout()
     _save(fig, path)
 
 
-def _error(trace: RunTrace, world: World, path: Path) -> None:
+def _error(trace: RunTrace, world: World, path: Path, label: RunLabel) -> None:
     times, errors = work_errors(trace)
     in_zone = zone_steps(trace, world).get(2, [])
     fig, ax = plt.subplots(figsize=(11, 4))
@@ -119,7 +145,7 @@ def _error(trace: RunTrace, world: World, path: Path) -> None:
     ax.axvspan(0, 0, color="red", alpha=0.25, label="support 1 in a zone")
     ax.set_xlabel("simulated time [s]")
     ax.set_ylabel("work UAV localization error [m]")
-    ax.set_title(f"scenario '{world.scenario.name}': {len(in_zone)} cycles of support 1 in a zone")
+    ax.set_title(f"{label}: {len(in_zone)} cycles of support 1 in a zone")
     ax.grid(alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
@@ -127,12 +153,22 @@ def _error(trace: RunTrace, world: World, path: Path) -> None:
 
 
 def _g_update(
-    world: World, sigma0: Sigma0Map, initial: np.ndarray, final: np.ndarray, path: Path
+    world: World,
+    sigma0: Sigma0Map,
+    initial: np.ndarray,
+    final: np.ndarray,
+    path: Path,
+    label: RunLabel,
 ) -> None:
     change = final - initial
     grid = sigma0.grid
-    index = np.unravel_index(int(np.argmax(np.abs(change))), change.shape)
-    point = grid.origin_m + grid.voxel_m * (np.array(index) + 0.5)
+    updated = int(np.count_nonzero(change))
+    if updated:  # through the most-changed voxel
+        index = np.unravel_index(int(np.argmax(np.abs(change))), change.shape)
+        point = grid.origin_m + grid.voxel_m * (np.array(index) + 0.5)
+    else:  # through the zone, where a learning G would have changed
+        point = _zone_centre(world, 7.5)
+        index = tuple(int(i) for i in grid.index_of(point[None])[0])
     fig, axes = plt.subplots(2, 3, figsize=(16, 9))
     panels = [("before", initial), ("after", final)]
     for row, (a, b, normal) in enumerate(((0, 1, 2), (0, 2, 1))):
@@ -142,29 +178,43 @@ def _g_update(
             draw_background(ax, world, g_map, point, a, b, normal, label="G [m]")
             ax.set_title(f"G {name}, {AXES[normal]} = {point[normal]:g} m")
             ax.set_aspect("equal")
-        ax = axes[row, 2]
-        k = int(index[normal])
-        delta = np.take(change, k, axis=normal)
-        lo, hi = grid.origin_m, grid.origin_m + grid.voxel_m * np.array(grid.shape)
-        limit = max(float(np.max(np.abs(delta))), 1e-6)
-        image = ax.imshow(
-            delta.T,
-            origin="lower",
-            extent=(lo[a], hi[a], lo[b], hi[b]),
-            cmap="coolwarm",
-            vmin=-limit,
-            vmax=limit,
-            interpolation="nearest",
-        )
-        plt.colorbar(image, ax=ax, label="G after - before [m]", shrink=0.8)
-        ax.set_title(f"updated voxels ({int(np.count_nonzero(change))} in the whole map)")
-        ax.set_aspect("equal")
+        _change_panel(axes[row, 2], np.take(change, int(index[normal]), axis=normal), grid, a, b)
+        axes[row, 2].set_title(_change_title(updated, label))
         for ax in axes[row]:
             ax.set_xlabel(f"{AXES[a]} [m]")
             ax.set_ylabel(f"{AXES[b]} [m]")
-    fig.suptitle(f"scenario '{world.scenario.name}': the GNSS-localizability map G")
+    fig.suptitle(f"{label}: the GNSS-localizability map G")
     fig.tight_layout()
     _save(fig, path)
+
+
+def _change_title(updated: int, label: RunLabel) -> str:
+    if updated:
+        voxels = "voxel" if updated == 1 else "voxels"
+        return f"G after - before ({updated} {voxels} changed in the whole map)"
+    return "G not learned (NAC): no change" if not label.learns else "G unchanged"
+
+
+def _change_panel(ax, delta: np.ndarray, grid, a: int, b: int) -> None:
+    """G after - before on one slice; nothing to colour when nothing changed."""
+    lo, hi = grid.origin_m, grid.origin_m + grid.voxel_m * np.array(grid.shape)
+    limit = float(np.max(np.abs(delta)))
+    if limit == 0:
+        ax.text(0.5, 0.5, "no change", ha="center", va="center", transform=ax.transAxes)
+        ax.set_xlim(lo[a], hi[a])
+        ax.set_ylim(lo[b], hi[b])
+        return
+    image = ax.imshow(
+        delta.T,
+        origin="lower",
+        extent=(lo[a], hi[a], lo[b], hi[b]),
+        cmap="coolwarm",
+        vmin=-limit,
+        vmax=limit,
+        interpolation="nearest",
+    )
+    plt.colorbar(image, ax=ax, label="G after - before [m]", shrink=0.8)
+    ax.set_aspect("equal")
 
 
 def _support_level(trace: RunTrace) -> float:
@@ -199,5 +249,4 @@ def _box3d(ax, lo: np.ndarray, hi: np.ndarray) -> None:
 
 
 def _save(fig, path: Path) -> None:
-    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=100, format="png"))
-    plt.close(fig)
+    save_figure(fig, path)

@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.collections import PolyCollection
 from matplotlib.patches import Rectangle
 
-from mission.procs.atomic import write_atomically
+from mission.analysis.figures import save_figure
 from mission.world.model import Sigma0Map, World
 
 
@@ -36,8 +36,7 @@ def plot_world(world: World, point: np.ndarray, path: Path) -> None:
         f"({point[0]:g}, {point[1]:g}, {point[2]:g}) m"
     )
     fig.tight_layout()
-    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
 
 
 def draw_background(

@@ -11,9 +11,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from mission.analysis.figures import save_figure
 from mission.analysis.world_plot import draw_background
 from mission.link.plan_files import Plan
-from mission.procs.atomic import write_atomically
 from mission.world.model import World
 
 COLORS = ("tab:blue", "tab:green", "tab:purple", "tab:olive", "tab:cyan")
@@ -41,8 +41,7 @@ def plot_plan(world: World, plan: Plan, path: Path) -> None:
         ax.legend(loc="upper right", fontsize=7)
     fig.suptitle(f"plan of scenario '{world.scenario.name}' (numbers: waypoint index)")
     fig.tight_layout()
-    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=100, format="png"))
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def _path(ax, points: np.ndarray, a: int, b: int, color: str, label: str) -> None:

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from mission.procs.atomic import write_atomically, write_text_atomically
 from mission.runs.trials import Trial
 
@@ -191,32 +193,39 @@ def write_tables(
 
 
 def _boxplots(rows: list[dict], path: str) -> None:
+    """Steps in multipath and completion time per scenario and method: a box each, every
+    run's value as a point over it, n under each box, both axes from 0."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     scenarios = _unique(r["scenario"] for r in rows)
-    figure, axes = plt.subplots(1, 2, figsize=(10, 4))
+    figure, axes = plt.subplots(1, 2, figsize=(11, 4.5))
     metrics = [
         ("multipath_steps_total", "steps in multipath"),
-        ("completion_time_s", "completion time [s]"),
+        ("completion_time_s", "completion time [s] (completed runs)"),
     ]
     for axis, (key, label) in zip(axes, metrics):
         data, names = [], []
         for scenario in scenarios:
             for method in ("ac", "nac"):
-                values = [
-                    r[key]
-                    for r in rows
-                    if r["scenario"] == scenario and r["method"] == method and r[key] is not None
-                ]
+                mine = [r for r in rows if r["scenario"] == scenario and r["method"] == method]
+                values = [r[key] for r in mine if r[key] is not None]
                 data.append(values or [math.nan])
-                names.append(f"{scenario}\n{method.upper()}")
-        axis.boxplot(data)
+                names.append(f"{scenario}\n{method.upper()}\nn = {len(values)}")
+        axis.boxplot(data, showfliers=False)
+        for position, values in enumerate(data, start=1):
+            spread = (
+                0.3 * (np.arange(len(values)) - (len(values) - 1) / 2) / max(len(values) - 1, 1)
+            )
+            axis.plot(position + spread, values, "o", ms=3, color="k", alpha=0.6)
         axis.set_xticks(range(1, len(names) + 1), names)
         axis.set_ylabel(label)
+        axis.set_ylim(bottom=0)
         axis.grid(axis="y", alpha=0.3)
+    seeds = len({r["seed"] for r in rows})
+    figure.suptitle(f"AC and NAC over {seeds} paired seeds: every run a point")
     figure.tight_layout()
     figure.savefig(path, format="png", dpi=100)
     plt.close(figure)

@@ -1,0 +1,91 @@
+"""Figures say which run they show and do not mislead: the scenario, method and seed in every
+title, NAC's G marked as not learned, box plots with every run and n, and PDF or SVG on ask."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mission.analysis import run_plot
+from mission.analysis.metrics import RunTrace
+from mission.analysis.run_plot import RunLabel, plot_run
+from mission.runs import batch_table
+from mission.world.model import World
+
+
+def _titles(fig) -> list[str]:
+    return [fig._suptitle.get_text()] + [ax.get_title() for ax in fig.axes if ax.get_title()]
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures plot_run makes, by file name, instead of files."""
+    made = {}
+    monkeypatch.setattr(run_plot, "save_figure", lambda fig, path: made.update({path.name: fig}))
+    return made
+
+
+def _trace() -> RunTrace:
+    trace = RunTrace()
+    for i, t in enumerate((0.5, 1.0, 1.5)):
+        trace.truth[(1, t)] = np.array([-12.0 + 0.1 * i, -3.0, 7.0])
+        trace.truth[(2, t)] = np.array([-5.0, 6.5, 8.5])  # in the Along zone
+        trace.estimates[t] = np.array([-12.0, -3.0, 7.0])
+        trace.ticks.add(t)
+    return trace
+
+
+@pytest.mark.parametrize("method", ["ac", "nac"])
+def test_every_title_names_the_run_and_nac_says_g_was_not_learned(
+    along, along_world, figures, tmp_path, method
+):
+    label = RunLabel("along", method, 3)
+    g = tmp_path / "g"
+    g.mkdir()
+    initial = along_world.sigma0_map().sigma_m
+    np.save(g / "G_initial.npy", initial)
+    final = initial.copy()
+    if method == "ac":
+        final[5, 30, 8] += 0.7  # one learned voxel near the zone
+    np.save(g / "G_final.npy", final)
+    plot_run(_trace(), World(along), g, tmp_path / "plots", label)
+    assert set(figures) == {"trajectories.png", "error.png", "g_update.png"}
+    for fig in figures.values():
+        assert fig._suptitle is None or "along, " + method.upper() + ", seed 3" in _titles(fig)[0]
+    assert "along, " + method.upper() + ", seed 3" in figures["error.png"].axes[0].get_title()
+    texts = " ".join(_titles(figures["trajectories.png"]) + _titles(figures["g_update.png"]))
+    colour_bars = [ax for ax in figures["g_update.png"].axes if ax.get_label() == "<colorbar>"]
+    if method == "nac":  # no colour bar for a change of nothing (it read 1e-6)
+        assert "G not learned (NAC)" in texts and "final G" not in texts
+        assert len(colour_bars) == 4  # G before and after, two slices
+    else:
+        assert "final G" in texts and "1 voxel changed" in texts
+        assert len(colour_bars) == 6
+
+
+def test_box_plots_show_every_run_n_and_start_at_zero(monkeypatch, tmp_path):
+    shown = {}
+    monkeypatch.setattr("matplotlib.pyplot.close", lambda fig: shown.update(fig=fig))
+    rows = [
+        {"scenario": "s", "method": m, "seed": seed, "multipath_steps_total": 10 * seed + 5,
+         "completion_time_s": 200.0 + seed if seed < 2 else None}
+        for m in ("ac", "nac") for seed in range(3)
+    ]  # fmt: skip
+    batch_table._boxplots(rows, str(tmp_path / "b.png"))
+    fig = shown["fig"]
+    assert "3 paired seeds" in fig._suptitle.get_text()
+    steps, times = fig.axes
+    assert [t.get_text() for t in steps.get_xticklabels()] == ["s\nAC\nn = 3", "s\nNAC\nn = 3"]
+    assert times.get_xticklabels()[0].get_text().endswith("n = 2")
+    points = [line for line in steps.get_lines() if line.get_marker() == "o"]
+    assert sum(len(line.get_xdata()) for line in points) == 6
+    assert steps.get_ylim()[0] == 0 and times.get_ylim()[0] == 0
+
+
+@pytest.mark.parametrize(("suffix", "magic"), [(".svg", b"<?xml"), (".pdf", b"%PDF")])
+def test_a_world_plot_is_written_as_its_suffix_asks(tmp_path, capsys, suffix, magic):
+    from mission.cli import entry_point
+
+    path = tmp_path / f"world{suffix}"
+    assert entry_point(["world", "along", "--plot", str(path)]) == 0
+    assert path.read_bytes().startswith(magic)
