@@ -22,6 +22,7 @@ from mission.procs.cli_common import (
     OneLineArgumentParser,
     check_port,
     check_seed,
+    check_speedup,
     die_with_parent,
     name_this_process,
     run_guarded,
@@ -113,8 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         check_port(args.base_port, "--base-port")
         check_port(args.base_port + scenario.task.supports, "--base-port")
     vehicles = _vehicle_addresses(args, scenario.task.supports)
-    if args.speedup is not None and not 0 < args.speedup <= 1000:
-        raise InputError("command line", "--speedup", "must be in (0, 1000]")
+    if args.speedup is not None:
+        check_speedup(args.speedup)
     waypoints = args.waypoints or Path(scenario.task.waypoints_dir)
     if not waypoints.is_dir():
         raise InputError("command line", "--waypoints", f"{waypoints} is not a directory")

@@ -13,7 +13,7 @@ import numpy as np
 
 from mission.config.errors import InputError
 from mission.link.impairment import link_settings
-from mission.procs.cli_common import check_seed, parse_point
+from mission.procs.cli_common import check_seed, check_speedup, parse_point
 from mission.procs.outputs import check_output_dir, check_output_file
 
 DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
@@ -101,8 +101,7 @@ def _speedup(args: argparse.Namespace) -> float | None:
             raise InputError("command line", "--speedup", "is for --realtime runs (add --realtime)")
         return None
     speedup = 1.0 if args.speedup is None else args.speedup
-    if not 0 < speedup <= 1000:
-        raise InputError("command line", "--speedup", f"must be in (0, 1000], got {speedup:g}")
+    check_speedup(speedup)
     return speedup
 
 

@@ -23,6 +23,7 @@ from mission.procs.cli_common import (
     OneLineArgumentParser,
     check_port,
     check_seed,
+    check_speedup,
     freeze_startup_heap,
     name_this_process,
     parse_point,
@@ -116,8 +117,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     identity = _identity(args.vehicle)
     name_this_process(f"vsim-{identity.name}")  # forked by `mission run`, it has no own argv
     check_seed(args.seed)
-    if args.speedup is not None and not (0 < args.speedup <= 1000):
-        raise InputError("command line", "--speedup", "must be in (0, 1000]")
+    if args.speedup is not None:
+        check_speedup(args.speedup)
     if args.socket_fd is not None and args.port is not None:
         raise InputError("command line", "--socket-fd", "cannot be combined with --port")
     port = args.port if args.port is not None else identity.default_port()
@@ -246,10 +247,9 @@ def _print_banner(vehicle: Vehicle, channels: Channels, clock: ClockSettings) ->
 
 def _check_home(world: World, home: np.ndarray) -> None:
     """A start position inside the workspace and outside the structure."""
-    if not world.in_workspace(home[None])[0]:
-        raise InputError("command line", "--home", f"{home.tolist()} is outside the workspace")
-    if world.structure.contains(home[None])[0]:
-        raise InputError("command line", "--home", f"{home.tolist()} is inside the structure")
+    problem = world.placement_problem(home)
+    if problem is not None:
+        raise InputError("command line", "--home", f"{home.tolist()} is {problem}")
 
 
 def _inherited_socket(fd: int | None, flag: str) -> socket.socket | None:

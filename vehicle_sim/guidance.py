@@ -38,13 +38,10 @@ def geofence_problem(
 ) -> tuple[str, str] | None:
     """Targets outside the workspace, inside the structure, or reached from ``believed`` (the
     autopilot fences in its own navigation frame) only through the structure."""
-    if not world.in_workspace(target[None])[0]:
-        return "geofence", "fence: outside workspace"
+    problem = world.placement_problem(target)
+    if problem is not None:
+        return "geofence", f"fence: {problem}"
     structure = world.structure
-    if structure is None:
-        return None
-    if structure.contains(target[None])[0]:
-        return "geofence", "fence: inside structure"
     if (
         np.linalg.norm(target - believed) > 0
         and structure.segments_blocked(believed[None], target[None])[0]

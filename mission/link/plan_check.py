@@ -48,7 +48,6 @@ def _check_row(world: KnownWorld, frame: GeodeticFrame, path: Path, row: Waypoin
         raise InputError(str(path), where, f"frame {row.frame} is not a global frame")
     position = np.asarray(row_position_enu(row, frame))
     shown = [round(float(v), 2) for v in position]
-    if not world.in_workspace(position[None])[0]:
-        raise InputError(str(path), where, f"{shown} (ENU) lies outside the workspace")
-    if world.structure.contains(position[None])[0]:
-        raise InputError(str(path), where, f"{shown} (ENU) lies inside the structure")
+    problem = world.placement_problem(position)
+    if problem is not None:
+        raise InputError(str(path), where, f"{shown} (ENU) lies {problem}")

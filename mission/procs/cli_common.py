@@ -65,6 +65,12 @@ def check_seed(seed: int, flag: str = "--seed") -> None:
         raise InputError("command line", flag, f"must not be negative, got {seed}")
 
 
+def check_speedup(speedup: float, flag: str = "--speedup") -> None:
+    """A real-time speed-up in (0, 1000]."""
+    if not 0 < speedup <= 1000:
+        raise InputError("command line", flag, f"must be in (0, 1000], got {speedup:g}")
+
+
 def check_port(port: int, flag: str, allow_any: bool = False) -> None:
     """A UDP port: 1..65535 (0, any free port, where ``allow_any``)."""
     lowest = 0 if allow_any else 1

@@ -64,6 +64,16 @@ class KnownWorld:
         lo, hi = np.array(self.workspace.min_m), np.array(self.workspace.max_m)
         return np.all((points >= lo) & (points <= hi), axis=1)
 
+    def placement_problem(self, point: np.ndarray) -> str | None:
+        """Why a vehicle cannot be at ``point`` ("outside the workspace", "inside the
+        structure"), or None where it can."""
+        point = np.asarray(point, dtype=float)[None]
+        if not self.in_workspace(point)[0]:
+            return "outside the workspace"
+        if self.structure.contains(point)[0]:
+            return "inside the structure"
+        return None
+
     def map_grid(self) -> VoxelGrid:
         """The voxel grid of the GNSS-localizability map."""
         return VoxelGrid.over(self.workspace, self.scenario.map.voxel_size_m)

@@ -212,8 +212,8 @@ def test_commands_are_acknowledged(frame):
 @pytest.mark.parametrize(
     ("target", "reason"),
     [
-        ((30.0, -10.0, 7.0), "outside workspace"),
-        ((0.0, 0.0, 8.5), "inside structure"),
+        ((30.0, -10.0, 7.0), "outside the workspace"),
+        ((0.0, 0.0, 8.5), "inside the structure"),
         ((0.0, 0.0, 9.5), "crosses structure"),  # on the deck, reached only through it
     ],
 )
