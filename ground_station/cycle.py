@@ -4,11 +4,12 @@
 2. fuse: selective fusion for the work UAV's xhat, feedback for each support's yhat_n;
 3. check arrival at the current work waypoint (|w_k - xhat| < 0.1 m advances k);
 4. learn: G updated around each yhat_n with the GNSS error seen there (AC only);
-5. plan: the work UAV's path (Algorithm 1) and each support's MPC problem.
+5. plan: the work UAV's path (Algorithm 1), then each support's MPC around it.
 
-:func:`control_cycle` runs the five steps; :func:`complete_cycle` then solves the supports'
-MPCs. The ground station sends the work UAV its command between the two: that command does not
-depend on the supports' plans, and the work vehicle steps while they are solved.
+:func:`control_cycle` runs the five steps up to the work UAV's plan; :func:`complete_cycle`
+then poses and solves the supports' MPCs. The ground station sends the work UAV its command
+between the two: that command does not depend on the supports' plans, and the work vehicle
+steps while they are solved.
 :func:`run_cycle` does both for callers that send nothing in between.
 """
 
@@ -33,7 +34,8 @@ from ground_station.work_mpc import WorkPrediction
 
 @dataclass(frozen=True)
 class CycleDecision:
-    """The five steps' results: the work UAV's command is known, the supports' MPCs posed."""
+    """The five steps' results: the work UAV's command is known, the supports' MPCs not yet
+    solved."""
 
     measurements: list[SupportMeasurement]
     fusion: FusionResult

@@ -1,8 +1,8 @@
-"""Step 5 of the control cycle, plan: the work UAV's path by Algorithm 1 and each support's
-MPC problem around it (:func:`plan`); then the supports' MPCs solved (:func:`solve_supports`).
+"""Step 5 of the control cycle, plan: the work UAV's path by Algorithm 1 (:func:`plan`), then
+each support's MPC posed around it and solved (:func:`solve_supports`).
 
 The two are apart so the work UAV's command, which does not depend on the supports' plans, can
-leave before they are solved.
+leave before their problems are even posed.
 """
 
 from __future__ import annotations
@@ -21,15 +21,15 @@ ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape start
 
 @dataclass(frozen=True)
 class FormationPlan:
-    """The work UAV's predicted path and each support's MPC problem, posed but not solved."""
+    """The work UAV's predicted path, and the supports whose MPCs are to be solved around it."""
 
     work: WorkPrediction
-    requests: list[PlanRequest]
+    supports: tuple[str, ...]
 
 
 def plan(state: StationState, models: Models, supports: Sequence[str]) -> FormationPlan:
-    """The work UAV's path from xhat (its command is the first point) and the MPC problem of
-    each of ``supports``; records the work UAV's commanded displacement in ``state``."""
+    """The work UAV's path from xhat (its command is the first point), for ``supports`` to
+    plan around; records the work UAV's commanded displacement in ``state``."""
     control = models.scenario.control
     work = predict_work(
         state.xhat,
@@ -41,15 +41,18 @@ def plan(state: StationState, models: Models, supports: Sequence[str]) -> Format
     )
     reach = control.s_max_work_m_s * control.t_cont_s
     state.last_work_command = reachable(state.xhat, work.command, reach)
-    return FormationPlan(work, [support_request(state, name, work, models) for name in supports])
+    return FormationPlan(work, tuple(supports))
 
 
 def solve_supports(
     state: StationState, formation: FormationPlan, models: Models
 ) -> dict[str, SupportPlan]:
-    """Every support's MPC solved (here, or shared with the helper process); each plan's
-    commanded displacement and path (the next warm start) go into ``state``."""
-    plans = models.planner.plan_all(formation.requests)
+    """Every support's MPC posed around the work UAV's path and solved (here, or shared with
+    the helper process); each plan's commanded displacement and path (the next warm start) go
+    into ``state``."""
+    work = formation.work
+    requests = [support_request(state, name, work, models) for name in formation.supports]
+    plans = models.planner.plan_all(requests)
     control = models.scenario.control
     reach = control.s_max_support_m_s * control.t_cont_s
     for name, support_plan in plans.items():
