@@ -1,7 +1,8 @@
 """The support MPC's NLPs compiled to shared libraries with the system C compiler, and cached.
 
 casadi generates C for the functions a solver evaluates (cost, constraints and their
-derivatives); compiled, a solve is ~1.5x faster than with casadi's interpreter. The first run
+derivatives); compiled, a plan takes about a quarter of the time it takes with casadi's
+interpreter (`interpreted_over_compiled_ratio` in `mission bench`). The first run
 generates and compiles (both NLPs at once, one compiler process each); later runs load the
 cached libraries and build nothing.
 """
@@ -40,7 +41,7 @@ class NlpBuild:
 
 def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> list[str | None]:
     """For each build, the functions its casadi solver needs, compiled into a shared library
-    with the system C compiler (about 1.5x faster solves than interpreting them), or None
+    with the system C compiler (about 4x faster plans than interpreting them), or None
     without one. The libraries not yet cached are compiled at the same time, one compiler
     process each.
 

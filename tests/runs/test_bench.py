@@ -40,6 +40,7 @@ def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
         mission.runs.detached, "run_detached", lambda *args, **kwargs: next(repeats)
     )
     monkeypatch.setattr(bench, "_scipy_over_casadi", lambda *args: 12.0)
+    monkeypatch.setattr(bench, "_interpreted_over_compiled", lambda *args: 4.5)
     rows = {r.name: r for r in bench.bench_ground_station(cycles=5, repeats=3)}
     # per-repeat medians 3, 4, 9 -> 4; p95s (linear) 80.8, 161, 9 -> 80.8; cycles 10, 20, 50 -> 20
     assert rows["support_mpc_solve_ms_median"].value == pytest.approx(4.0)
@@ -50,6 +51,8 @@ def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
     assert rows["gcs_cycle_ms_median"].ok
     assert rows["scipy_over_casadi_ratio"].value == 12.0
     assert rows["scipy_over_casadi_ratio"].ok
+    assert rows["interpreted_over_compiled_ratio"].value == 4.5
+    assert rows["interpreted_over_compiled_ratio"].ok is None  # a reference, no target
     with pytest.raises(StopIteration):  # exactly three repeats were run
         next(repeats)
 
