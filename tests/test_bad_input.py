@@ -208,6 +208,11 @@ CASES = [
         ["work.waypoints", "line 2"],
     ),
     ("wpl-home-only", lambda t: _wpl(t, _rows()), ["work.waypoints", "at least one waypoint"]),
+    (
+        "wpl-too-many",
+        lambda t: _wpl(t, _rows(*[7.0] * 600)),
+        ["work.waypoints", "mission_capacity"],
+    ),
     ("wpl-unequal", lambda t: _wpl(t, _rows(7.0)), ["support-1.waypoints", "pair by index"]),
     ("wpl-frame", lambda t: _wpl(t, _rows(7.0, frame=1)), ["work.waypoints", "item 1", "frame"]),
     ("wpl-command", lambda t: _wpl(t, _rows(7.0, command=178)), ["item 1", "command 178"]),

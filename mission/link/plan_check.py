@@ -17,9 +17,10 @@ from mission.world.model import KnownWorld
 
 def check_plan_files(world: KnownWorld, directory: Path, names: Sequence[str]) -> None:
     """Each vehicle's ``<name>.waypoints`` in ``directory``: home and at least one waypoint,
-    every row a navigation command in a global frame, every position inside the workspace and
-    outside the structure; every support with as many waypoints as the work UAV (they pair by
-    index). The first problem raises InputError naming the file and the item."""
+    no more items than a vehicle stores, every row a navigation command in a global frame,
+    every position inside the workspace and outside the structure; every support with as many
+    waypoints as the work UAV (they pair by index). The first problem raises InputError naming
+    the file and the item."""
     frame = GeodeticFrame(world.scenario.world.anchor)
     counts = {}
     for name in names:
@@ -29,6 +30,10 @@ def check_plan_files(world: KnownWorld, directory: Path, names: Sequence[str]) -
         rows = read_waypoints(path)
         if len(rows) < 2:
             raise InputError(str(path), "", "needs a home row and at least one waypoint")
+        capacity = world.scenario.vehicle.mission_capacity
+        if len(rows) > capacity:
+            problem = f"{len(rows)} items, more than a vehicle stores (vehicle.mission_capacity "
+            raise InputError(str(path), "", problem + f"{capacity})")
         for row in rows:
             _check_row(world, frame, path, row)
         counts[name] = len(rows) - 1
