@@ -109,10 +109,6 @@ class World(KnownWorld):
         """This world without its zones (the same structure)."""
         return KnownWorld(self.scenario, self.structure)
 
-    def zone_index(self, points: np.ndarray) -> np.ndarray:
-        """Index of the first zone containing each point, -1 outside every zone."""
-        return self.zones.index(points)
-
     def in_zone(self, points: np.ndarray) -> np.ndarray:
         """True for points inside a multipath zone."""
         return self.zones.contains(points)
