@@ -82,7 +82,10 @@ class SupportMpc:
         grid: VoxelGrid,
         camera: CameraModel,
         sigma0: np.ndarray | None = None,
+        compiled: bool = True,
     ) -> None:
+        """``compiled=False``: casadi interprets the NLP, even with a C compiler (slower, the
+        same plans)."""
         self.control = control
         self.grid = grid
         self.camera = camera
@@ -92,7 +95,8 @@ class SupportMpc:
         self.horizon = control.horizon_steps
         self.window = mpc_window_shape(control, grid.voxel_m, grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
-        nlp = build_support_nlp(control, self._window_grid, with_prior=sigma0 is not None)
+        with_prior = sigma0 is not None
+        nlp = build_support_nlp(control, self._window_grid, with_prior, compiled)
         self._solvers, self._cost = nlp.solvers, nlp.cost
         self._anchors = LosAnchors(control, camera, grid, self.sigma0)
         d_max_sq = control.d_max_support_m**2

@@ -116,8 +116,11 @@ class SupportNlp:
     cost: BufferedFunction
 
 
-def build_support_nlp(control: ControlSettings, window: VoxelGrid, with_prior: bool) -> SupportNlp:
-    """The NLP over a window of voxels, its functions compiled when a C compiler is there."""
+def build_support_nlp(
+    control: ControlSettings, window: VoxelGrid, with_prior: bool, compiled: bool = True
+) -> SupportNlp:
+    """The NLP over a window of voxels, its functions compiled when a C compiler is there (and
+    ``compiled`` asks for it; else casadi interprets them: the same plans, slower)."""
     horizon = control.horizon_steps
     s = NlpSymbols.make(horizon, window.n_voxels, with_prior)
     hermite = inlined_hermite(window)  # G_s and the prior's, per step
@@ -147,7 +150,8 @@ def build_support_nlp(control: ControlSettings, window: VoxelGrid, with_prior: b
     nlps = {
         b: {"x": ca.vec(s.v), "p": parameters, "f": cost, "g": g} for b, g in constraints.items()
     }
-    return SupportNlp(_solvers(control.mpc_solver, nlps), BufferedFunction(cost_function, ("f",)))
+    solvers = _solvers(control.mpc_solver, nlps, compiled)
+    return SupportNlp(solvers, BufferedFunction(cost_function, ("f",)))
 
 
 def _cost(control: ControlSettings, s: NlpSymbols, hermite: ca.Function) -> ca.MX:
@@ -166,7 +170,9 @@ def _cost(control: ControlSettings, s: NlpSymbols, hermite: ca.Function) -> ca.M
     return cost
 
 
-def _solvers(plugin: str, nlps: dict[str, dict[str, ca.MX]]) -> dict[str, BufferedFunction]:
+def _solvers(
+    plugin: str, nlps: dict[str, dict[str, ca.MX]], compiled: bool
+) -> dict[str, BufferedFunction]:
     """One solver per branch, from compiled libraries where a C compiler is there."""
     options = SOLVER_OPTIONS[plugin]
     unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
@@ -179,7 +185,7 @@ def _solvers(plugin: str, nlps: dict[str, dict[str, ca.MX]]) -> dict[str, Buffer
         def private_directory() -> str:
             return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
 
-        libraries = compiled_nlps(builds, private_directory)
+        libraries = compiled_nlps(builds, private_directory) if compiled else [None] * len(builds)
         for branch, build, library in zip(nlps, builds, libraries, strict=True):
             loaded = build.nlp if library is None else library
             solver = ca.nlpsol(build.name, plugin, loaded, options)

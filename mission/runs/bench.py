@@ -193,18 +193,12 @@ def _interpreted_over_compiled(world, plan, indices=range(2, 12)) -> float:
     one's, on the three supports' problems at ten waypoints (the same plans either way)."""
     import numpy as np
 
-    from ground_station import support_nlp
     from ground_station.support_mpc import SupportMpc
     from ground_station.work_mpc import predict_work
 
     control, grid, sigma0 = world.scenario.control, world.map_grid(), world.sigma0_map().sigma_m
     compiled = SupportMpc(control, grid, world.camera, sigma0)
-    compile_them = support_nlp.compiled_nlps
-    support_nlp.compiled_nlps = lambda builds, _: [None] * len(builds)
-    try:
-        interpreted = SupportMpc(control, grid, world.camera, sigma0)
-    finally:
-        support_nlp.compiled_nlps = compile_them
+    interpreted = SupportMpc(control, grid, world.camera, sigma0, compiled=False)
     requests = []
     for i in indices:
         work = predict_work(

@@ -105,10 +105,14 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
 
     from ground_station import support_nlp
 
-    monkeypatch.setattr(support_nlp, "compiled_nlps", lambda builds, _: [None] * len(builds))
+    def no_compiling(*_):
+        raise AssertionError("compiled=False compiles nothing")
+
+    monkeypatch.setattr(support_nlp, "compiled_nlps", no_compiling)
     control = replaced(along_world.scenario.control, mpc_solver=solver)
+    sigma0 = along_world.sigma0_map().sigma_m
     interpreted = SupportMpc(
-        control, along_world.map_grid(), along_world.camera, along_world.sigma0_map().sigma_m
+        control, along_world.map_grid(), along_world.camera, sigma0, compiled=False
     )
     requests = [r for index in (2, 6, 9) for r in _requests(along_world, local.mpc, index)]
     for request in requests:
