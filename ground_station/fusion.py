@@ -3,7 +3,8 @@
 Each support n with a fix p_n and a valid observation r_n gives the likelihood
 N(mu_n, Sigma_n), mu_n = p_n + r_n, Sigma_n = Sigma_GNSS(p_n) + Sigma_r(r_n). Supports whose
 likelihoods correlate (Pearson, over a broad particle set around the predicted position) with
-at least half of the contributing supports form the consistent set S; xhat is the candidate
+at least half of the contributing supports (``agreement: paper``: half of all N) form the
+consistent set S; xhat is the candidate
 particle maximising sum_{n in S} log f(x; mu_n, Sigma_n). Interpretations: MODEL.md 3.2.
 """
 
@@ -137,7 +138,8 @@ def selective_fusion(
     densities = [LogDensity.of(s.mu, s.sigma) for s in contributing]
     rho = correlation_matrix([density(broad) for density in densities])
     agree = (rho > settings.rho_threshold).sum(axis=1)
-    in_s = [i for i, count in enumerate(agree) if count >= len(contributing) / 2]
+    voters = len(supports) if settings.agreement == "paper" else len(contributing)
+    in_s = [i for i, count in enumerate(agree) if count >= voters / 2]
     fallback = not in_s
     if fallback:
         in_s = list(range(len(contributing)))

@@ -69,7 +69,8 @@ def support_request(
     yhat = state.yhat[name]
     g = models.g
     initial = float(hermite_zero_slope(g.initial, g.grid, yhat)[0])
-    escape = bool(g.smoothed(yhat)[0] > initial + ESCAPE_MARGIN_M)
+    risen = bool(g.smoothed(yhat)[0] > initial + ESCAPE_MARGIN_M)
+    escape = risen and models.scenario.control.escape_starts
     return models.support_mpc.request(
         name,
         yhat,

@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
-from mission import subcommands
+from mission import study_commands, subcommands
 from mission.link.impairment import add_link_arguments
 from mission.procs.cli_common import (
     OneLineArgumentParser,
@@ -31,6 +31,7 @@ def build_parser() -> OneLineArgumentParser:
     _add_bench_parser(commands)
     _add_run_parser(commands)
     _add_batch_parser(commands)
+    _add_study_parser(commands)
     return parser
 
 
@@ -165,9 +166,44 @@ def _add_batch_parser(commands) -> None:
     )
     batch.add_argument("--trials", type=int, default=15, help="seeds 0..N-1 (default 15)")
     batch.add_argument("--methods", default="ac,nac", help="comma-separated (default ac,nac)")
-    batch.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
+    batch.add_argument("--jobs", type=int, default=2, help="runs in parallel")
     batch.add_argument(
         "--out", type=Path, default=Path("logs/batch"), help="default logs/batch (resumable)"
+    )
+
+
+def _add_study_parser(commands) -> None:
+    """``mission study``'s arguments."""
+    study = commands.add_parser(
+        "study",
+        help="run a study file (a sweep of scenarios x points x methods x seeds); "
+        "write results.csv and report.md",
+    )
+    study.add_argument("file", type=Path, metavar="FILE.yaml", help="the study file")
+    study.add_argument(
+        "--engine",
+        choices=["local", "ray"],
+        default="local",
+        help="local: child processes of this one; ray: Ray tasks (pip install -e '.[ray]')",
+    )
+    study.add_argument(
+        "--address",
+        metavar="ADDR",
+        help="--engine ray: the cluster to join (default: RAY_ADDRESS, else a Ray started here)",
+    )
+    study.add_argument(
+        "--jobs",
+        type=int,
+        help="runs at once (default: local, this machine's cores; ray, as the cluster allows)",
+    )
+    study.add_argument(
+        "--out", type=Path, metavar="DIR", help="where it goes (default results/NAME; resumable)"
+    )
+    study.add_argument(
+        "--keep",
+        choices=["all", "logs", "summary"],
+        default="all",
+        help="of each run's folder: all; logs (all but G's snapshots); summary (and scenario)",
     )
 
 
@@ -180,7 +216,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "bench": subcommands.bench,
         "analyze": subcommands.analyze,
         "plan": subcommands.plan,
-        "batch": subcommands.batch,
+        "batch": study_commands.batch,
+        "study": study_commands.study,
     }[args.command]
     return command(args)
 

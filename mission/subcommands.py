@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     check_seed(args.seed)
     speedup = _speedup(args)
     scenario = load_scenario(args.scenario)
-    _preflight(scenario)
+    preflight(scenario)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
     check_output_dir(out, "--out")
@@ -124,46 +124,7 @@ def run_line(summary: dict, timeout_s: float) -> str:
     )
 
 
-def batch(args: argparse.Namespace) -> int:
-    """``mission batch``."""
-    from mission.config.scenario import load_scenario
-    from mission.runs.batch import BatchOptions, Trial, run_batch
-
-    if not 1 <= args.trials <= 1000:
-        raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
-    if not 1 <= args.jobs <= 64:
-        raise InputError("command line", "--jobs", f"must be in [1, 64], got {args.jobs}")
-    check_output_dir(args.out, "--out")
-    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    if not methods or any(m not in ("ac", "nac") for m in methods):
-        raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
-    scenarios = [load_scenario(s) for s in args.scenarios]
-    for scenario in scenarios:
-        _preflight(scenario)
-    names = [s.name for s in scenarios]
-    if len(set(names)) != len(names):
-        raise InputError("command line", "SCENARIO", f"the same scenario twice: {names}")
-    trials = [
-        Trial(scenario, name, method, seed)
-        for scenario, name in zip(args.scenarios, names)
-        for method in methods
-        for seed in range(args.trials)
-    ]
-    try:
-        result = run_batch(BatchOptions(trials, args.out, args.jobs))
-    except KeyboardInterrupt:
-        print(f"batch interrupted; finished runs are kept in {args.out}: run again to resume")
-        return 130
-    print((args.out / "table.md").read_text(), end="")
-    print(
-        f"{result['finished']} runs finished, {result['skipped']} already done, "
-        f"{len(result['failed'])} failed; wall {result['wall_time_s']:.1f} s; "
-        f"results in {args.out}"
-    )
-    return 1 if result["failed"] else 0
-
-
-def _preflight(scenario) -> None:
+def preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts: the structure's
     mesh (loading the known world) and every vehicle's waypoint file."""
     from mission.link.plan_check import check_plan_files
@@ -179,7 +140,7 @@ def plan(args: argparse.Namespace) -> int:
     """``mission plan``."""
     from mission.link.plan_files import write_plan
     from mission.planning.planner import plan_supports
-    from mission.planning.zone_placement import place_along, place_wall
+    from mission.planning.zone_placement import place_along, place_along_pair, place_wall
     from mission.world.model import World
 
     if args.plot is not None:
@@ -207,6 +168,18 @@ def plan(args: argparse.Namespace) -> int:
         )
     except (ValueError, IndexError):
         print("a Wall zone: no place on this plan")
+    if world.scenario.task.supports >= 2:
+        try:
+            pair = place_along_pair(plan, world.workspace)
+            print("two Along zones for this plan (two supports in multipath at once):")
+            for support, segment, zone in pair:
+                print(
+                    f"  support {support + 1}, segment w_{support + 1},{segment + 1} -> "
+                    f"w_{support + 1},{segment + 2}: min_m {list(zone.min_m)}, "
+                    f"max_m {list(zone.max_m)}"
+                )
+        except ValueError as reason:
+            print(f"two Along zones: {reason}")
     if args.plot is not None:
         from mission.planning.plan_plot import plot_plan
 
@@ -237,7 +210,7 @@ def plan_directory(out: Path | None, scenario) -> Path:
 
 def analyze(args: argparse.Namespace) -> int:
     """``mission analyze``."""
-    from mission.analysis.metrics import analyze_tlog
+    from mission.analysis.run_metrics import run_metrics
     from mission.config.scenario import load_scenario
 
     tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
@@ -251,7 +224,7 @@ def analyze(args: argparse.Namespace) -> int:
     if scenario_name is None:
         raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
     scenario = load_scenario(scenario_name)
-    metrics = analyze_tlog(tlog, scenario)
+    metrics = run_metrics(tlog, scenario)
     if not metrics["control_cycles"]:
         raise InputError(str(tlog), "", "holds no control cycle of a ground station")
     merged = {**previous, **metrics}

@@ -177,8 +177,12 @@ def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
 
 def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
     """The tlog-determined metrics of summary.json."""
-    trace = read_tlog(tlog, scenario)
-    steps = zone_steps(trace, World(scenario))
+    return trace_metrics(read_tlog(tlog, scenario), World(scenario))
+
+
+def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
+    """The metrics of summary.json that a tlog determines, from its trace."""
+    steps = zone_steps(trace, world)
     _, errors = work_errors(trace)
     counts = {f"support-{s - 1}": len(steps.get(s, [])) for s in trace.supports}
     return {
@@ -202,15 +206,9 @@ def _stats(values: list[float]) -> dict[str, float | None]:
     }
 
 
-def mpc_stats(records: Path) -> dict[str, float | None]:
-    """Median and p95 of the support-MPC solve times in records.jsonl."""
-    import json
-
-    times = [
-        m["ms"]
-        for line in records.read_text().splitlines()
-        for m in json.loads(line)["mpc"].values()
-    ]
+def mpc_stats(records: list[dict[str, Any]]) -> dict[str, float | None]:
+    """Median and p95 of the support-MPC solve times in a run's records."""
+    times = [m["ms"] for record in records for m in record["mpc"].values()]
     if not times:
         return {"median": None, "p95": None}
     return {

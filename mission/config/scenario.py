@@ -49,12 +49,45 @@ def resolve_scenario_path(name_or_path: str) -> Path:
     raise ScenarioError(name_or_path, "", f"no such scenario (embedded ones: {names})")
 
 
-def load_scenario(name_or_path: str) -> Scenario:
-    """Load, merge and validate a scenario given by embedded name or file path."""
+def load_scenario(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scenario:
+    """Load, merge and validate a scenario given by embedded name or file path; ``overrides``
+    (dotted keys, see :func:`resolved_mapping`) are layered on top."""
+    path = resolve_scenario_path(name_or_path)
+    merged = resolved_mapping(name_or_path, overrides)
+    merged["source"] = str(path)
+    return scenario_from_mapping(merged, path)
+
+
+def resolved_mapping(name_or_path: str, overrides: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Every setting of a scenario, its layers merged, file references absolute; with
+    ``overrides`` ({"fusion.rho_threshold": 0.5, ...}) merged last, as if written at the end of
+    the scenario's own file (a relative path in one is relative to that file)."""
     path = resolve_scenario_path(name_or_path)
     merged = _load_layers(path, depth=0)
     merged.pop("extends", None)
-    merged["source"] = str(path)
+    if overrides:
+        layer = nest_dotted(overrides)
+        _absolutise_paths(layer, path.parent)
+        merged = merge_settings(merged, layer)
+    return merged
+
+
+def nest_dotted(overrides: dict[str, Any]) -> dict[str, Any]:
+    """{"a.b": 1, "a.c": 2} -> {"a": {"b": 1, "c": 2}}."""
+    nested: dict[str, Any] = {}
+    for key, value in overrides.items():
+        *parents, leaf = str(key).split(".")
+        level = nested
+        for part in parents:
+            level = level.setdefault(part, {})
+            if not isinstance(level, dict):
+                raise ValueError(f"{key}: {part} is set as a value and as a mapping")
+        level[leaf] = value
+    return nested
+
+
+def scenario_from_mapping(merged: dict[str, Any], path: Path) -> Scenario:
+    """Validate a merged mapping (with its ``source``) as the scenario of file ``path``."""
     try:
         scenario = build_settings(Scenario, merged)
         check_resources(scenario)

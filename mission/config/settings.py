@@ -11,27 +11,15 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Literal
 
+from mission.config.checks import non_negative as _non_negative
+from mission.config.checks import positive as _positive
+from mission.config.checks import require as _require
 from mission.config.errors import FieldProblem
 from mission.config.limit_settings import LimitSettings
+from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
 
 Vec3 = tuple[float, float, float]
 MAX_COORDINATE_M = 100_000.0  # a world-frame coordinate beyond this is not a site's metres
-
-
-def _require(condition: bool, field: str, problem: str) -> None:
-    if not condition:
-        raise FieldProblem(field, problem)
-
-
-def _positive(owner: object, *names: str) -> None:
-    for name in names:
-        _require(getattr(owner, name) > 0, name, f"must be positive, got {getattr(owner, name)}")
-
-
-def _non_negative(owner: object, *names: str) -> None:
-    for name in names:
-        value = getattr(owner, name)
-        _require(value >= 0, name, f"must not be negative, got {value}")
 
 
 @dataclass(frozen=True)
@@ -220,6 +208,7 @@ class FusionSettings:
     local_particles: int
     broad_sigma_m: float
     rho_threshold: float
+    agreement: Literal["contributing", "paper"]  # S: agreeing with half of these, or of N
 
     def __post_init__(self) -> None:
         _require(self.broad_particles >= 2, "broad_particles", "must be at least 2")
@@ -265,6 +254,7 @@ class ControlSettings:
     support_max_sigma0_m: float
     los_penalty: Literal["visible-point", "paper"]
     mpc_solver: Literal["fatrop", "ipopt"]
+    escape_starts: bool  # where G has risen, also start the support MPC from escaping paths
 
     def __post_init__(self) -> None:
         _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
@@ -319,56 +309,6 @@ class TaskSettings:
     def __post_init__(self) -> None:
         _require(1 <= self.supports <= 50, "supports", f"must be in 1..50, got {self.supports}")
         _require(len(self.work_waypoints_m) >= 2, "work_waypoints_m", "needs at least 2 points")
-
-
-@dataclass(frozen=True)
-class PlannerSettings:
-    """The offline planner of the support UAVs' paths (MODEL.md 3.3; the paper's ref. [18])."""
-
-    lattice_m: float
-    w_gnss_per_m2: float
-    w_relative_per_m2: float
-    w_move_per_m: float
-    w_spread: float
-    min_separation_m: float
-    clearance_m: float
-    min_altitude_m: float
-    max_range_fraction: float
-    rounds: int
-
-    def __post_init__(self) -> None:
-        _positive(self, "lattice_m", "max_range_fraction")
-        _non_negative(self, "w_gnss_per_m2", "w_relative_per_m2", "w_move_per_m", "w_spread")
-        _non_negative(self, "min_separation_m", "clearance_m", "min_altitude_m")
-        _require(self.max_range_fraction <= 1, "max_range_fraction", "must be at most 1")
-        _require(self.rounds >= 1, "rounds", "must be at least 1")
-
-
-@dataclass(frozen=True)
-class VehicleSettings:
-    """A simulated vehicle: realism, failsafe, telemetry rates and protocol timing.
-
-    Rates are in simulated time; the ``*_wall_s`` timeouts are wall-clock seconds, divided by
-    the speed-up in real-time mode.
-    """
-
-    tracking_noise_m: float
-    failsafe_s: float
-    heartbeat_hz: float
-    status_hz: float
-    sensor_hz: float
-    lockstep_timeout_wall_s: float
-    truth_timeout_wall_s: float
-    mission_timeout_wall_s: float
-    mission_retries: int
-    mission_capacity: int
-
-    def __post_init__(self) -> None:
-        _non_negative(self, "tracking_noise_m")
-        _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
-        _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
-        _require(self.mission_retries >= 0, "mission_retries", "must not be negative")
-        _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")
 
 
 @dataclass(frozen=True)

@@ -36,29 +36,71 @@ def inside(box: Box, points: np.ndarray) -> np.ndarray:
 
 def place_along(plan: Plan, workspace: Box, support: int = 0) -> tuple[Box, int]:
     """The Along zone and the (0-based) index i of the segment w_i -> w_{i+1} it encloses."""
-    path = plan.supports[support]
-    others = [path_samples(p) for n, p in enumerate(plan.supports) if n != support]
     best: tuple[float, int, Box] | None = None
-    for i in range(len(path) - 1):
-        a, b = path[i], path[i + 1]
-        if np.linalg.norm((b - a)[:2]) < 2.0:
+    for i in range(len(plan.supports[support]) - 1):
+        try:
+            score, box = _along_on_segment(plan, workspace, support, i)
+        except ValueError:
             continue
-        axis = int(np.argmax(np.abs((b - a)[:2])))
-        size = np.array([1.0, 1.0, 2.0])
-        size[axis] = 5.0
-        segment = path_samples(np.array([a, b]))
-        for center in _grid_centers(segment):
-            box = _box(center, size)
-            if not workspace.contains_box(box) or any(inside(box, o).any() for o in others):
-                continue
-            enclosed = inside(box, segment).sum() * SAMPLE_M
-            holds_waypoint = inside(box, path).any()
-            score = enclosed - (10.0 if holds_waypoint else 0.0)
-            if enclosed >= 2.0 and (best is None or score > best[0] + 1e-9):
-                best = (score, i, box)
+        if best is None or score > best[0] + 1e-9:
+            best = (score, i, box)
     if best is None:
         raise ValueError("no place for an Along zone on this plan")
     return best[2], best[1]
+
+
+def place_along_pair(plan: Plan, workspace: Box) -> list[tuple[int, int, Box]]:
+    """Two Along zones on two supports' paths, over the same or neighbouring segments (so both
+    supports are in multipath at once), each enclosing its own support's path and no other's:
+    [(support, segment index, zone), ...], 0-based. Prefers the same segment, then segments in
+    the middle of the task, then the first supports."""
+    options = {}
+    for support, path in enumerate(plan.supports):
+        for i in range(len(path) - 1):
+            try:
+                options[(support, i)] = _along_on_segment(plan, workspace, support, i)[1]
+            except ValueError:
+                continue
+    middle = (len(plan.supports[0]) - 2) / 2
+    pairs = [
+        (abs(i - j), abs((i + j) / 2 - middle), n, m, i, j)
+        for (n, i), (m, j) in itertools.combinations(sorted(options), 2)
+        if n != m and abs(i - j) <= 1 and not _overlap(options[(n, i)], options[(m, j)])
+    ]
+    if not pairs:
+        raise ValueError("no two supports' segments side by side can both get an Along zone")
+    *_, n, m, i, j = min(pairs)
+    return [(n, i, options[(n, i)]), (m, j, options[(m, j)])]
+
+
+def _along_on_segment(plan: Plan, workspace: Box, support: int, i: int) -> tuple[float, Box]:
+    """The best Along zone on support ``support``'s segment i and its score (metres of the
+    segment enclosed, less 10 if it holds a waypoint)."""
+    path = plan.supports[support]
+    others = [path_samples(p) for n, p in enumerate(plan.supports) if n != support]
+    a, b = path[i], path[i + 1]
+    if np.linalg.norm((b - a)[:2]) < 2.0:
+        raise ValueError("segment too short")
+    axis = int(np.argmax(np.abs((b - a)[:2])))
+    size = np.array([1.0, 1.0, 2.0])
+    size[axis] = 5.0
+    segment = path_samples(np.array([a, b]))
+    best: tuple[float, Box] | None = None
+    for center in _grid_centers(segment):
+        box = _box(center, size)
+        if not workspace.contains_box(box) or any(inside(box, o).any() for o in others):
+            continue
+        enclosed = inside(box, segment).sum() * SAMPLE_M
+        score = enclosed - (10.0 if inside(box, path).any() else 0.0)
+        if enclosed >= 2.0 and (best is None or score > best[0] + 1e-9):
+            best = (score, box)
+    if best is None:
+        raise ValueError("no place on this segment")
+    return best
+
+
+def _overlap(a: Box, b: Box) -> bool:
+    return all(a.min_m[k] < b.max_m[k] and b.min_m[k] < a.max_m[k] for k in range(3))
 
 
 def place_wall(plan: Plan, workspace: Box, support: int = 0, waypoint: int = 5) -> Box:

@@ -285,7 +285,7 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     one run per scenario and method, made as the batch makes them) / jobs."""
     import tempfile
 
-    from mission.runs.batch import helper_has_a_core
+    from mission.studies.local_engine import helper_has_a_core
 
     factors, walls = [], []
     in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)

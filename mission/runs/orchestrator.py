@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from mission.analysis.metrics import analyze_tlog, mpc_stats
+from mission.analysis.run_metrics import run_metrics
 from mission.config.settings import Scenario
 from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
@@ -151,12 +151,11 @@ def _summary(options: RunOptions, scenario: Scenario, wall: float) -> dict[str, 
         "scenario_source": scenario.source,
         "method": options.method,
         "seed": options.seed,
-        **analyze_tlog(options.out_dir / "gcs.tlog", scenario),
+        **run_metrics(options.out_dir / "gcs.tlog", scenario),
     }
     simulated = (summary["control_cycles"] or 0) * scenario.control.t_cont_s
     summary["wall_time_s"] = round(wall, 3)
     summary["realtime_factor"] = round(simulated / wall, 3) if wall > 0 else None
-    summary["mpc_solve_ms"] = mpc_stats(options.out_dir / "records.jsonl")
     link_file = options.out_dir / "link.json"
     if link_file.is_file():
         summary["link"] = json.loads(link_file.read_text())

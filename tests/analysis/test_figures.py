@@ -9,7 +9,7 @@ import pytest
 from mission.analysis import run_plot
 from mission.analysis.metrics import RunTrace
 from mission.analysis.run_plot import RunLabel, plot_run
-from mission.runs import batch_table
+from mission.studies import table3 as batch_table
 from mission.world.model import World
 
 

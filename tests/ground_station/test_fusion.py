@@ -17,6 +17,7 @@ from ground_station.fusion import (
     selective_fusion,
     support_feedback,
 )
+from mission.config.settings import FusionSettings
 from mission.link.plan_files import read_plan
 
 
@@ -144,11 +145,7 @@ def test_feedback_fallbacks():
 
 def test_blind_and_fallback():
     rng = np.random.default_rng(0)
-    settings = type(
-        "S",
-        (),
-        {"broad_particles": 50, "local_particles": 10, "broad_sigma_m": 1.0, "rho_threshold": 0.0},
-    )()
+    settings = FusionSettings(50, 10, 1.0, 0.0, "contributing")
     nothing = [SupportMeasurement("a", None, None, None, None)]
     assert selective_fusion(nothing, np.zeros(3), settings, rng).blind
     far = [
@@ -157,6 +154,34 @@ def test_blind_and_fallback():
     ]
     result = selective_fusion(far, np.zeros(3), settings, rng)
     assert result.fallback and set(result.consistent) == {"a", "b", "c"}
+
+
+def test_agreement_counts_against_the_contributing_supports_or_against_all_n():
+    """Five supports, four contributing: a and b agree, c and d each agree only with
+    themselves. Against the four that contribute, a and b reach half (2 of 4) and form S;
+    against N = 5 (the paper's count) nobody reaches 2.5, S is empty and all four are fused."""
+
+    def support(name, position, observed=True):
+        relative = np.zeros(3) if observed else None
+        sigma = 0.01 * np.eye(3) if observed else None
+        return SupportMeasurement(
+            name, np.array(position, float), 0.01 * np.eye(3), relative, sigma
+        )
+
+    supports = [
+        support("a", [0.0, 0.0, 0.0]),
+        support("b", [0.05, 0.0, 0.0]),
+        support("c", [2.0, 0.0, 0.0]),
+        support("d", [0.0, -2.0, 0.0]),
+        support("e", [0.0, 2.0, 0.0], observed=False),
+    ]
+    for agreement, fallback, consistent in (
+        ("contributing", False, {"a", "b"}),
+        ("paper", True, {"a", "b", "c", "d"}),
+    ):
+        settings = FusionSettings(300, 100, 1.0, 0.0, agreement)
+        result = selective_fusion(supports, np.zeros(3), settings, np.random.default_rng(0))
+        assert result.fallback is fallback and set(result.consistent) == consistent
 
 
 def test_a_cycles_covariances_in_one_batch_equal_one_at_a_time(along_world, plan):

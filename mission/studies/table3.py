@@ -1,4 +1,4 @@
-"""The paper's Table 3 from a batch's summaries: results.csv, table.md, table.csv, box plots.
+"""The paper's Table 3 from a study's result rows: table.md, table.csv, box plots.
 
 Per scenario and method: mean and std of steps in multipath and of completion time (completed
 runs), the completion rate; per scenario, the reduction (NAC - AC) / NAC of the means and a
@@ -15,28 +15,11 @@ import statistics
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from mission.procs.atomic import write_atomically, write_text_atomically
-from mission.runs.trials import Trial
-
-RESULT_COLUMNS = [
-    "scenario",
-    "method",
-    "seed",
-    "completed",
-    "completion_time_s",
-    "multipath_steps_total",
-    "multipath_steps",
-    "work_error_mean_m",
-    "work_error_p95_m",
-    "control_cycles",
-    "wall_time_s",
-    "realtime_factor",
-    "mpc_solve_ms_median",
-]
+from mission.studies.stats import wilcoxon_p
 
 
 @dataclass(frozen=True)
@@ -58,36 +41,6 @@ class MethodStats:
     time_mean: float | None
     time_std: float | None
     completion_rate: float | None
-
-
-def result_rows(trials: Iterable[Trial], summaries: dict[Trial, dict[str, Any]]) -> list[dict]:
-    """One row per finished trial, in the batch's order."""
-    rows = []
-    for trial in trials:
-        summary = summaries.get(trial)
-        if summary is None:
-            continue
-        error = summary.get("work_error_m") or {}
-        rows.append(
-            {
-                "scenario": trial.scenario_name,
-                "method": trial.method,
-                "seed": trial.seed,
-                "completed": summary["completed"],
-                "completion_time_s": summary["completion_time_s"],
-                "multipath_steps_total": summary["multipath_steps_total"],
-                "multipath_steps": " ".join(
-                    f"{k}={v}" for k, v in sorted(summary["multipath_steps"].items())
-                ),
-                "work_error_mean_m": error.get("mean"),
-                "work_error_p95_m": error.get("p95"),
-                "control_cycles": summary["control_cycles"],
-                "wall_time_s": summary.get("wall_time_s"),
-                "realtime_factor": summary.get("realtime_factor"),
-                "mpc_solve_ms_median": (summary.get("mpc_solve_ms") or {}).get("median"),
-            }
-        )
-    return rows
 
 
 def method_stats(rows: list[dict]) -> MethodStats:
@@ -114,17 +67,6 @@ def compare(ac: dict[int, float | None], nac: dict[int, float | None]) -> Compar
     mean_n = statistics.fmean(n)
     reduction = 100 * (mean_n - statistics.fmean(a)) / mean_n if mean_n else None
     return Comparison(reduction, wilcoxon_p(a, n), len(seeds))
-
-
-def wilcoxon_p(a: list[float], b: list[float]) -> float | None:
-    """Two-sided paired Wilcoxon signed-rank p-value; 1.0 when every pair is equal."""
-    from scipy.stats import wilcoxon
-
-    if len(a) < 2:
-        return None
-    if all(x == y for x, y in zip(a, b)):
-        return 1.0
-    return float(wilcoxon(a, b).pvalue)
 
 
 def table_rows(rows: list[dict]) -> list[dict]:
@@ -178,12 +120,8 @@ def table_markdown(table: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_tables(
-    out_dir: Path, trials: list[Trial], summaries: dict[Trial, dict[str, Any]]
-) -> None:
-    """(Re)write results.csv, table.md, table.csv and boxplots.png from the summaries."""
-    rows = result_rows(trials, summaries)
-    write_text_atomically(out_dir / "results.csv", _csv(rows, RESULT_COLUMNS))
+def write_tables(out_dir: Path, rows: list[dict]) -> None:
+    """(Re)write table.md, table.csv and boxplots.png from a study's result rows."""
     table = table_rows(rows)
     columns = list(table[0]) if table else ["scenario", "method", "runs"]
     write_text_atomically(out_dir / "table.csv", _csv(table, columns))

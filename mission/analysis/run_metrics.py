@@ -1,0 +1,26 @@
+"""Every metric of a run's summary.json that its files determine: the tlog's (Table 3's), the
+support MPCs' solve times and the diagnostics, which also read ``records.jsonl``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from mission.analysis.diagnostics import diagnostics, read_records
+from mission.analysis.metrics import mpc_stats, read_tlog, trace_metrics
+from mission.config.settings import Scenario
+from mission.world.model import World
+
+
+def run_metrics(tlog: Path, scenario: Scenario) -> dict[str, Any]:
+    """The tlog's metrics, plus ``mpc_solve_ms`` and ``diagnostics`` where the ground
+    station's ``records.jsonl`` lies beside the tlog."""
+    trace = read_tlog(tlog, scenario)
+    world = World(scenario)
+    metrics = trace_metrics(trace, world)
+    records_file = tlog.parent / "records.jsonl"
+    if records_file.is_file():
+        records = read_records(records_file)
+        metrics["mpc_solve_ms"] = mpc_stats(records)
+        metrics["diagnostics"] = diagnostics(trace, records, world, scenario)
+    return metrics

@@ -1,0 +1,59 @@
+"""Settings of the offline planner and of a simulated vehicle."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mission.config.checks import non_negative as _non_negative
+from mission.config.checks import positive as _positive
+from mission.config.checks import require as _require
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """The offline planner of the support UAVs' paths (MODEL.md 3.3; the paper's ref. [18])."""
+
+    lattice_m: float
+    w_gnss_per_m2: float
+    w_relative_per_m2: float
+    w_move_per_m: float
+    w_spread: float
+    min_separation_m: float
+    clearance_m: float
+    min_altitude_m: float
+    max_range_fraction: float
+    rounds: int
+
+    def __post_init__(self) -> None:
+        _positive(self, "lattice_m", "max_range_fraction")
+        _non_negative(self, "w_gnss_per_m2", "w_relative_per_m2", "w_move_per_m", "w_spread")
+        _non_negative(self, "min_separation_m", "clearance_m", "min_altitude_m")
+        _require(self.max_range_fraction <= 1, "max_range_fraction", "must be at most 1")
+        _require(self.rounds >= 1, "rounds", "must be at least 1")
+
+
+@dataclass(frozen=True)
+class VehicleSettings:
+    """A simulated vehicle: realism, failsafe, telemetry rates and protocol timing.
+
+    Rates are in simulated time; the ``*_wall_s`` timeouts are wall-clock seconds, divided by
+    the speed-up in real-time mode.
+    """
+
+    tracking_noise_m: float
+    failsafe_s: float
+    heartbeat_hz: float
+    status_hz: float
+    sensor_hz: float
+    lockstep_timeout_wall_s: float
+    truth_timeout_wall_s: float
+    mission_timeout_wall_s: float
+    mission_retries: int
+    mission_capacity: int
+
+    def __post_init__(self) -> None:
+        _non_negative(self, "tracking_noise_m")
+        _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
+        _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
+        _require(self.mission_retries >= 0, "mission_retries", "must not be negative")
+        _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")

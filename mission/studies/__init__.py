@@ -1,0 +1,1 @@
+"""Studies: sweeps of scenarios, points, methods, seeds. Imports: config, link, procs, analysis."""

@@ -1,0 +1,130 @@
+"""``report.md`` of a study: per point and method, each metric's mean and 95 % CI; AC against
+NAC paired by seed, with a bootstrap CI and the Wilcoxon p; a figure of each metric against
+each swept key. Written from ``results.csv``'s rows alone, so the same rows give the same
+report (no wall times, no dates).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mission.procs.atomic import write_text_atomically
+from mission.studies.report_figures import write_figures
+from mission.studies.results import metric_values, paired
+from mission.studies.spec import StudySpec
+from mission.studies.stats import bootstrap_ci, mean_ci, wilcoxon_p
+
+# (column, what it is); completion time over completed runs only
+METRICS = (
+    ("completion_time_s", "completion time [s]"),
+    ("multipath_steps_total", "steps in multipath"),
+    ("work_error_m.mean", "work UAV error, mean [m]"),
+    ("inclusion_rate", "fused while in a zone"),
+    ("diagnostics.empty_s_cycles", "cycles with S empty"),
+    ("diagnostics.time_beyond_flight_s", "time beyond pure flight [s]"),
+)
+PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
+
+
+def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) -> None:
+    """report.md and its figures (in ``figures/``)."""
+    figures = write_figures(out_dir / "figures", spec, rows, METRICS)
+    lines = [f"# Study: {spec.name}", ""]
+    if spec.description:
+        lines += [spec.description, ""]
+    lines += [
+        f"{len(rows)} of {spec.size} runs finished"
+        + (f", {failed} failed" if failed else "")
+        + f": {len(spec.scenarios)} scenario(s) x {len(spec.points)} point(s) x "
+        f"{len(spec.methods)} method(s) x {len(spec.seeds)} seed(s). "
+        "Means with their 95 % confidence interval (Student t); completion time over the "
+        "runs that completed.",
+        "",
+        "## Per point and method",
+        "",
+        *_means_table(spec, rows),
+    ]
+    if set(spec.methods) == {"ac", "nac"}:
+        lines += ["", "## AC against NAC, paired by seed", "", *_paired_table(spec, rows)]
+    if figures:
+        lines += ["", "## Figures", ""]
+        lines += [f"![{path.stem}](figures/{path.name})" for path in figures]
+    write_text_atomically(out_dir / "report.md", "\n".join(lines) + "\n")
+
+
+def _groups(spec: StudySpec, rows: list[dict]):
+    for scenario in dict.fromkeys(r["scenario"] for r in rows):
+        for number, point in enumerate(spec.points):
+            mine = [r for r in rows if r["scenario"] == scenario and r["point"] == number]
+            if mine:
+                yield scenario, point.label, mine
+
+
+def _means_table(spec: StudySpec, rows: list[dict]) -> list[str]:
+    header = "| scenario | point | method | runs | completed | " + " | ".join(
+        label for _, label in METRICS
+    )
+    lines = [header + " |", "|" + "---|" * (5 + len(METRICS))]
+    for scenario, label, mine in _groups(spec, rows):
+        for method in spec.methods:
+            runs = [r for r in mine if r["method"] == method]
+            if not runs:
+                continue
+            done = sum(1 for r in runs if r.get("completed"))
+            cells = [_mean_cell(metric_values(runs, column)) for column, _ in METRICS]
+            lines.append(
+                f"| {scenario} | {label} | {method.upper()} | {len(runs)} | {done} | "
+                + " | ".join(cells)
+                + " |"
+            )
+    return lines
+
+
+def _paired_table(spec: StudySpec, rows: list[dict]) -> list[str]:
+    lines = [
+        "| scenario | point | pairs | "
+        + " | ".join(f"{label}: AC - NAC [95 % CI] (p)" for label in _paired_labels())
+        + " | NAC fused while in a zone |",
+        "|" + "---|" * (4 + len(PAIRED)),
+    ]
+    for scenario, label, mine in _groups(spec, rows):
+        cells, pairs = [], 0
+        for column in PAIRED:
+            a, n = paired(mine, column)
+            pairs = max(pairs, len(a))
+            cells.append(_difference_cell(a, n))
+        nac = [r for r in mine if r["method"] == "nac"]
+        inclusion = _mean_cell(metric_values(nac, "inclusion_rate"))
+        lines.append(
+            f"| {scenario} | {label} | {pairs} | " + " | ".join(cells) + f" | {inclusion} |"
+        )
+    return lines
+
+
+def _paired_labels() -> list[str]:
+    names = dict(METRICS)
+    return [names[c] for c in PAIRED]
+
+
+def _mean_cell(values: list[float]) -> str:
+    mean, half = mean_ci(values)
+    if mean is None:
+        return "-"
+    return _number(mean) if half is None else f"{_number(mean)} +/- {_number(half)}"
+
+
+def _difference_cell(a: list[float], n: list[float]) -> str:
+    mean, low, high = bootstrap_ci([x - y for x, y in zip(a, n)])
+    if mean is None:
+        return "-"
+    base = sum(n) / len(n)
+    share = f" ({100 * mean / base:+.1f} %)" if base else ""
+    interval = "" if low is None else f" [{_number(low)}, {_number(high)}]"
+    p = wilcoxon_p(a, n)
+    test = "" if p is None else f" (p = {p:.3g})"
+    return f"{_number(mean, signed=True)}{share}{interval}{test}"
+
+
+def _number(value: float, signed: bool = False) -> str:
+    digits = 1 if abs(value) >= 10 else 3 if abs(value) < 1 else 2
+    return f"{value:+.{digits}f}" if signed else f"{value:.{digits}f}"

@@ -1,0 +1,141 @@
+"""The figures of a study's report: each metric against each swept key (mean and 95 % CI,
+one line per method and per value of the other keys), and the paired AC - NAC completion-time
+difference against how often NAC's fusion let a support in while it was in a zone."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mission.analysis.figures import save_figure
+from mission.studies.results import metric_values, paired
+from mission.studies.spec import StudySpec
+from mission.studies.stats import bootstrap_ci, mean_ci
+
+
+def write_figures(
+    folder: Path, spec: StudySpec, rows: list[dict], metrics: tuple[tuple[str, str], ...]
+) -> list[Path]:
+    """Write the figures; return their paths (none without rows)."""
+    if not rows:
+        return []
+    import matplotlib
+
+    matplotlib.use("Agg")
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    scenarios = list(dict.fromkeys(r["scenario"] for r in rows))
+    for key in spec.swept_keys:
+        values = [p.as_dict().get(key) for p in spec.points]
+        if not all(_scalar(v) for v in values) or len(set(map(repr, values))) < 2:
+            continue  # a list or mapping per point, or one value for all: nothing to plot
+        path = folder / f"metrics-vs-{key}.png"
+        _metrics_against(path, spec, rows, scenarios, key, metrics)
+        written.append(path)
+    if set(spec.methods) == {"ac", "nac"}:
+        path = folder / "time-difference-vs-inclusion.png"
+        if _difference_against_inclusion(path, spec, rows, scenarios):
+            written.append(path)
+    for stale in set(folder.glob("*.png")) - set(written):
+        stale.unlink()  # from an earlier version of the study
+    return written
+
+
+def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
+    import matplotlib.pyplot as plt
+
+    values = list(dict.fromkeys(p.as_dict().get(key) for p in spec.points))
+    numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+    positions = {v: (v if numeric else i) for i, v in enumerate(values)}
+    figure, axes = plt.subplots(
+        len(metrics),
+        len(scenarios),
+        figsize=(4.2 * len(scenarios), 2.6 * len(metrics)),
+        squeeze=False,
+    )
+    for column_index, scenario in enumerate(scenarios):
+        for row_index, (column, label) in enumerate(metrics):
+            axis = axes[row_index][column_index]
+            for (rest, method), points in _lines(spec, key).items():
+                xs, ys, errors = [], [], []
+                for number, value in points:
+                    mine = [
+                        r
+                        for r in rows
+                        if r["scenario"] == scenario
+                        and r["point"] == number
+                        and r["method"] == method
+                    ]
+                    mean, half = mean_ci(metric_values(mine, column))
+                    if mean is not None:
+                        xs.append(positions[value])
+                        ys.append(mean)
+                        errors.append(half or 0.0)
+                if xs:
+                    name = method.upper() + (f", {rest}" if rest else "")
+                    axis.errorbar(xs, ys, yerr=errors, marker="o", capsize=3, label=name)
+            if not numeric:
+                axis.set_xticks(range(len(values)), [str(v) for v in values])
+            axis.set_xlabel(key)
+            axis.set_ylabel(label, fontsize=8)
+            axis.grid(alpha=0.3)
+            if row_index == 0:
+                axis.set_title(scenario)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    figure.legend(handles, labels, loc="upper right", fontsize=7)
+    figure.suptitle(f"{spec.name}: each metric against {key} (mean, 95 % CI)")
+    figure.tight_layout(rect=(0, 0, 0.85, 0.97))
+    save_figure(figure, path)
+
+
+def _scalar(value: object) -> bool:
+    return value is None or isinstance(value, str | int | float | bool)
+
+
+def _lines(spec: StudySpec, key: str) -> dict[tuple[str, str], list[tuple[int, object]]]:
+    """{(the other keys' values, method): [(point number, this key's value), ...]}."""
+    lines: dict[tuple[str, str], list[tuple[int, object]]] = {}
+    for number, point in enumerate(spec.points):
+        overrides = point.as_dict()
+        rest = ", ".join(f"{k}={v}" for k, v in point.overrides if k != key)
+        for method in spec.methods:
+            lines.setdefault((rest, method), []).append((number, overrides.get(key)))
+    return lines
+
+
+def _difference_against_inclusion(path, spec, rows, scenarios) -> bool:
+    import matplotlib.pyplot as plt
+
+    figure, axis = plt.subplots(figsize=(6.5, 4.5))
+    drawn = False
+    for scenario in scenarios:
+        xs, ys, low_high = [], [], []
+        for number, _ in enumerate(spec.points):
+            mine = [r for r in rows if r["scenario"] == scenario and r["point"] == number]
+            nac = [r for r in mine if r["method"] == "nac"]
+            inclusion, _ = mean_ci(metric_values(nac, "inclusion_rate"))
+            a, n = paired(mine, "completion_time_s")
+            mean, low, high = bootstrap_ci([x - y for x, y in zip(a, n)])
+            if inclusion is None or mean is None:
+                continue
+            xs.append(inclusion)
+            ys.append(mean)
+            low_high.append(
+                (
+                    mean - (low if low is not None else mean),
+                    (high if high is not None else mean) - mean,
+                )
+            )
+        if xs:
+            drawn = True
+            axis.errorbar(xs, ys, yerr=list(zip(*low_high)), fmt="o", capsize=3, label=scenario)
+    if not drawn:
+        plt.close(figure)
+        return False
+    axis.axhline(0.0, color="k", lw=0.8)
+    axis.set_xlabel("NAC: share of in-zone cycles the fusion let a support in")
+    axis.set_ylabel("completion time, AC - NAC [s] (95 % bootstrap CI)")
+    axis.set_title(f"{spec.name}: one point per study point and scenario")
+    axis.legend()
+    axis.grid(alpha=0.3)
+    save_figure(figure, path)
+    return True

@@ -1,0 +1,227 @@
+"""A study file: which scenarios, methods, seeds and points (sets of overrides) to run.
+
+```yaml
+name: fusion-leakage          # names the output folder (default: the file's stem)
+description: ...
+scenarios: [along, wall]      # embedded names or paths (relative to this file)
+methods: [ac, nac]            # default: both
+seeds: 15                     # 0..14; or a list [0, 3, 7]; or {start: 100, count: 15}
+grid:                         # every combination of these (dotted scenario keys)
+  fusion.rho_threshold: [0.0, 0.25, 0.5]
+  fusion.broad_sigma_m: [0.5, 1.0, 2.0]
+points:                       # and/or a list of override sets, each crossed with the grid
+  - {}
+  - {fusion.agreement: paper}
+tables: [table3]              # also write the paper's Table 3 (table.md, table.csv, boxplots)
+```
+
+Every (scenario, point) is resolved and validated before anything runs: a bad key or value
+is one line naming this file, the point and the key.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mission.config.errors import InputError, ScenarioError
+from mission.config.scenario import load_scenario, read_yaml_mapping, resolve_scenario_path
+from mission.config.settings import Scenario
+
+METHODS = ("ac", "nac")
+TABLES = ("table3",)
+_KEYS = {"name", "description", "scenarios", "methods", "seeds", "grid", "points", "tables"}
+MAX_RUNS = 1_000_000
+
+
+@dataclass(frozen=True, eq=False)
+class Point:
+    """One set of overrides: ((dotted key, value), ...) in the study file's order."""
+
+    overrides: tuple[tuple[str, Any], ...]
+
+    def as_dict(self) -> dict[str, Any]:
+        """{dotted key: value}."""
+        return dict(self.overrides)
+
+    @property
+    def label(self) -> str:
+        """``key=value, ...`` (``defaults`` for none)."""
+        return ", ".join(f"{k}={v}" for k, v in self.overrides) or "defaults"
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A validated study."""
+
+    name: str
+    description: str
+    source: Path
+    scenarios: tuple[str, ...]  # as resolvable references (embedded name or absolute path)
+    methods: tuple[str, ...]
+    seeds: tuple[int, ...]
+    points: tuple[Point, ...]
+    tables: tuple[str, ...]
+
+    @property
+    def swept_keys(self) -> list[str]:
+        """The dotted keys some point sets, in order of first appearance."""
+        keys: dict[str, None] = {}
+        for point in self.points:
+            keys.update((k, None) for k, _ in point.overrides)
+        return list(keys)
+
+    @property
+    def size(self) -> int:
+        """How many runs the study has."""
+        return len(self.scenarios) * len(self.points) * len(self.methods) * len(self.seeds)
+
+
+def load_study(path: Path) -> StudySpec:
+    """Read and validate a study file (every scenario at every point included)."""
+    source = str(path)
+    data = read_yaml_mapping(path) if path.is_file() else _missing(path)
+    unknown = sorted(set(map(str, data)) - _KEYS)
+    if unknown:
+        raise InputError(source, unknown[0], f"unknown key (expected one of: {_known()})")
+    name = data.get("name", path.stem)
+    if not isinstance(name, str) or not name or "/" in name or name.startswith("."):
+        raise InputError(source, "name", "must be a plain folder name")
+    listed = data.get("scenarios")
+    if not isinstance(listed, list) or not listed:
+        raise InputError(source, "scenarios", "must be a non-empty list of names or paths")
+    scenarios = tuple(
+        _listed_scenario(path, reference, i) for i, reference in enumerate(listed)
+    )
+    methods_given = data.get("methods", list(METHODS))
+    if not isinstance(methods_given, list) or not methods_given:
+        raise InputError(source, "methods", "must be a non-empty list (ac, nac)")
+    methods = tuple(str(m).lower() for m in methods_given)
+    for method in methods:
+        if method not in METHODS:
+            raise InputError(source, "methods", f"{method!r} is not one of ac, nac")
+    tables_given = data.get("tables", [])
+    if not isinstance(tables_given, list):
+        raise InputError(source, "tables", f"must be a list (of {', '.join(TABLES)})")
+    tables = tuple(tables_given)
+    for table in tables:
+        if table not in TABLES:
+            raise InputError(source, "tables", f"{table!r} is not one of {', '.join(TABLES)}")
+    spec = StudySpec(
+        name=name,
+        description=str(data.get("description", "")).strip(),
+        source=path.resolve(),
+        scenarios=scenarios,
+        methods=tuple(dict.fromkeys(methods)),
+        seeds=_seeds(source, data.get("seeds", 1)),
+        points=_points(source, data.get("grid"), data.get("points")),
+        tables=tables,
+    )
+    if tables and len(spec.points) > 1:
+        raise InputError(source, "tables", "Table 3 is for a study of one point (no grid)")
+    if spec.size > MAX_RUNS:
+        raise InputError(source, "", f"{spec.size} runs; at most {MAX_RUNS} in one study")
+    validate_points(spec)
+    return spec
+
+
+def validate_points(spec: StudySpec) -> dict[tuple[str, int], Scenario]:
+    """Every (scenario, point number) resolved as a scenario; the first bad one raises, naming
+    the study file, the point and the key."""
+    resolved = {}
+    for scenario in spec.scenarios:
+        for number, point in enumerate(spec.points):
+            try:
+                resolved[(scenario, number)] = load_scenario(scenario, point.as_dict())
+            except ScenarioError as error:
+                where = f"point {number} ({point.label}): {error.where}".rstrip(": ")
+                raise InputError(str(spec.source), where, error.problem) from None
+            except ValueError as error:
+                raise InputError(str(spec.source), f"point {number}", str(error)) from None
+    return resolved
+
+
+def _missing(path: Path) -> dict[str, Any]:
+    raise InputError(str(path), "", "no such study file")
+
+
+def _known() -> str:
+    return ", ".join(sorted(_KEYS))
+
+
+def _listed_scenario(study: Path, reference: Any, index: int) -> str:
+    if not isinstance(reference, str) or not reference:
+        raise InputError(str(study), f"scenarios[{index}]", "must be a name or a path")
+    return scenario_reference(study.parent, reference, f"scenarios[{index}]", str(study))
+
+
+def scenario_reference(
+    folder: Path, reference: str, where: str, source: str = "command line"
+) -> str:
+    """An embedded name as it is; a path made absolute against ``folder``; one that names
+    no scenario raises naming ``source`` and ``where``."""
+    candidate = Path(reference)
+    if candidate.suffix in (".yaml", ".yml") and not candidate.is_absolute():
+        reference = str((folder / candidate).resolve())
+    try:
+        resolve_scenario_path(reference)
+    except ScenarioError as error:
+        raise InputError(source, where, error.problem) from None
+    return reference
+
+
+def _seeds(source: str, value: Any) -> tuple[int, ...]:
+    if isinstance(value, bool):
+        raise InputError(source, "seeds", "must be a count, a list or {start, count}")
+    if isinstance(value, int):
+        seeds = list(range(value))
+    elif isinstance(value, list):
+        seeds = value
+    elif isinstance(value, dict) and set(value) == {"start", "count"}:
+        start, count = value["start"], value["count"]
+        if not all(isinstance(v, int) and not isinstance(v, bool) for v in (start, count)):
+            raise InputError(source, "seeds", "start and count must be integers")
+        seeds = list(range(start, start + count))
+    else:
+        raise InputError(source, "seeds", "must be a count, a list or {start, count}")
+    if not seeds:
+        raise InputError(source, "seeds", "names no seed")
+    for seed in seeds:
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
+            raise InputError(source, "seeds", f"{seed!r} is not a seed in 0..2^32-1")
+    if len(set(seeds)) != len(seeds):
+        raise InputError(source, "seeds", "a seed appears twice")
+    return tuple(seeds)
+
+
+def _points(source: str, grid: Any, points: Any) -> tuple[Point, ...]:
+    """The points: each of ``points`` (default: one with no override) crossed with the grid."""
+    if grid is None:
+        grid = {}
+    if not isinstance(grid, dict):
+        raise InputError(source, "grid", "must map dotted keys to lists of values")
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise InputError(source, f"grid.{key}", "must be a non-empty list of values")
+    if points is None:
+        points = [{}]
+    if not isinstance(points, list) or not points:
+        raise InputError(source, "points", "must be a non-empty list of override mappings")
+    for number, point in enumerate(points):
+        if not isinstance(point, dict):
+            raise InputError(source, f"points[{number}]", "must map dotted keys to values")
+        clash = sorted(set(map(str, point)) & set(map(str, grid)))
+        if clash:
+            raise InputError(source, f"points[{number}].{clash[0]}", "is also a grid key")
+    combos = list(itertools.product(*grid.values()))
+    expanded = [
+        Point(tuple((str(k), v) for k, v in point.items()) + tuple(zip(map(str, grid), combo)))
+        for point in points
+        for combo in combos
+    ]
+    if len({json.dumps(p.overrides, sort_keys=True) for p in expanded}) != len(expanded):
+        raise InputError(source, "points", "the same point appears twice")
+    return tuple(expanded)

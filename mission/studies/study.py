@@ -1,0 +1,152 @@
+"""``mission study``: run what a study file asks, on an engine, into a folder.
+
+``OUT/runs/<scenario>-<method>-<seed>-<key>/`` holds each run (its summary names the key);
+``OUT/results.csv`` and ``OUT/report.md`` (with ``OUT/figures/``) are rewritten from the
+finished summaries after every run, so an interrupted study loses nothing, and running it
+again skips what is done and ends with the same results and report.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol, TextIO
+
+from mission.procs.atomic import write_text_atomically
+from mission.studies.execute import Keep, finished_summary
+from mission.studies.local_engine import Done
+from mission.studies.report import write_report
+from mission.studies.results import result_row, results_csv
+from mission.studies.runkeys import StudyRun, code_version, study_runs
+from mission.studies.spec import StudySpec, validate_points
+from mission.studies.table3 import write_tables
+
+REPORT_EVERY_S = 60.0  # the report and its figures, while runs finish (and at the end)
+
+
+class Engine(Protocol):
+    """Runs a list of study runs, reporting each as it finishes."""
+
+    description: str
+
+    def run(self, runs: list[StudyRun], runs_dir: Path, keep: Keep, done: Done) -> None:
+        """Run them all; stop what is running on any exit."""
+
+
+@dataclass(frozen=True)
+class StudyOutcome:
+    """What a call of :func:`run_study` did."""
+
+    finished: int
+    skipped: int
+    failed: list[str]
+    wall_time_s: float
+
+
+def plan_runs(spec: StudySpec) -> list[StudyRun]:
+    """Every run of the study, keyed (validates every point first)."""
+    resolved = validate_points(spec)
+    names = {scenario: resolved[(scenario, 0)].name for scenario in spec.scenarios}
+    return study_runs(spec, names, code_version())
+
+
+def run_study(
+    spec: StudySpec,
+    out_dir: Path,
+    engine: Engine,
+    keep: Keep = "all",
+    progress: TextIO = sys.stderr,
+) -> StudyOutcome:
+    """Run what is not finished yet and write results.csv and report.md."""
+    runs = plan_runs(spec)
+    runs_dir = out_dir / "runs"
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    summaries: dict[StudyRun, dict[str, Any]] = {}
+    for run in runs:
+        summary = finished_summary(run, runs_dir / run.folder)
+        if summary is not None:
+            summaries[run] = summary
+    pending = [run for run in runs if run not in summaries]
+    failed: list[str] = []
+    bar = ProgressBar(len(runs), len(summaries), progress, engine.description)
+    start = last_report = time.monotonic()
+
+    def done(run: StudyRun, summary: dict | None, wall: float) -> None:
+        nonlocal last_report
+        if summary is None:
+            failed.append(run.folder)
+            bar.advance(f"{run.folder}: FAILED (see {runs_dir / run.folder})")
+        else:
+            summaries[run] = summary
+            bar.advance(f"{run.folder}: {_one_line(summary)}")
+        report = time.monotonic() - last_report > REPORT_EVERY_S
+        write_outputs(out_dir, spec, runs, summaries, len(failed), report)
+        last_report = time.monotonic() if report else last_report
+
+    try:
+        if pending:
+            engine.run(pending, runs_dir, keep, done)
+    finally:
+        write_outputs(out_dir, spec, runs, summaries, len(failed), report=True)
+    return StudyOutcome(
+        len(summaries) - (len(runs) - len(pending)),
+        len(runs) - len(pending),
+        failed,
+        round(time.monotonic() - start, 1),
+    )
+
+
+def write_outputs(
+    out_dir: Path,
+    spec: StudySpec,
+    runs: list[StudyRun],
+    summaries: dict[StudyRun, dict[str, Any]],
+    failed: int,
+    report: bool,
+) -> None:
+    """results.csv from the summaries; with ``report``, report.md and its figures too (and
+    Table 3 if the study asks)."""
+    rows = [result_row(spec, run, summaries[run]) for run in runs if run in summaries]
+    write_text_atomically(out_dir / "results.csv", results_csv(spec, rows))
+    if report:
+        write_report(out_dir, spec, rows, failed)
+        if "table3" in spec.tables:
+            write_tables(out_dir, rows)
+
+
+def _one_line(summary: dict[str, Any]) -> str:
+    done = (
+        f"completed at {summary['completion_time_s']:.1f} s"
+        if summary["completed"]
+        else "NOT completed"
+    )
+    return (
+        f"{done}, {summary['multipath_steps_total']} steps in multipath, "
+        f"wall {summary['wall_time_s']:.1f} s"
+    )
+
+
+class ProgressBar:
+    """``[#####.....] 12/60  mm:ss left  <last run>`` lines, one per finished run."""
+
+    def __init__(self, total: int, done: int, stream: TextIO, engine: str) -> None:
+        self.total, self.done, self.stream = total, done, stream
+        self.started, self.start_done = time.monotonic(), done
+        self.stream.write(f"study: {total} runs, {done} already finished; {engine}\n")
+        self.stream.flush()
+
+    def advance(self, message: str) -> None:
+        """Count one more finished run and print the bar."""
+        self.done += 1
+        width = 30
+        filled = round(width * self.done / max(self.total, 1))
+        elapsed = time.monotonic() - self.started
+        rate = elapsed / max(self.done - self.start_done, 1)
+        left = int(rate * (self.total - self.done))
+        self.stream.write(
+            f"[{'#' * filled}{'.' * (width - filled)}] {self.done}/{self.total} "
+            f"{left // 60:02d}:{left % 60:02d} left  {message}\n"
+        )
+        self.stream.flush()

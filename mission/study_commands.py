@@ -1,0 +1,98 @@
+"""What ``mission study`` and ``mission batch`` (a study of one point, with Table 3) do."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from mission.config.errors import InputError
+from mission.procs.outputs import check_output_dir
+from mission.subcommands import preflight
+
+MAX_JOBS = 256
+
+
+def study(args: argparse.Namespace) -> int:
+    """``mission study``."""
+    from mission.studies.spec import load_study
+
+    spec = load_study(args.file)
+    out = args.out or Path("results") / spec.name
+    return _run(spec, out, args)
+
+
+def batch(args: argparse.Namespace) -> int:
+    """``mission batch``: Table 3's study of the given scenarios, methods and seeds."""
+    from mission.studies.spec import METHODS, Point, StudySpec, scenario_reference
+
+    if not 1 <= args.trials <= 1000:
+        raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    if not methods or any(m not in METHODS for m in methods):
+        raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
+    scenarios = [scenario_reference(Path.cwd(), s, "SCENARIO") for s in args.scenarios]
+    spec = StudySpec(
+        name="batch",
+        description="The paper's Table 3: AC and NAC over paired seeds.",
+        source=Path("command line"),
+        scenarios=tuple(scenarios),
+        methods=tuple(dict.fromkeys(methods)),
+        seeds=tuple(range(args.trials)),
+        points=(Point(()),),
+        tables=("table3",),
+    )
+    args.engine, args.address, args.keep = "local", None, "all"
+    status = _run(spec, args.out, args)
+    if (args.out / "table.md").is_file():
+        print((args.out / "table.md").read_text(), end="")
+    return status
+
+
+def _run(spec, out: Path, args: argparse.Namespace) -> int:
+    """Check everything, then run the study on the chosen engine."""
+    from mission.studies.study import plan_runs, run_study
+
+    jobs = args.jobs
+    if jobs is not None and not 1 <= jobs <= MAX_JOBS:
+        raise InputError("command line", "--jobs", f"must be in [1, {MAX_JOBS}], got {jobs}")
+    check_output_dir(out, "--out")
+    names = _check_scenarios(spec)
+    if len(set(names.values())) != len(names):
+        raise InputError(str(spec.source), "scenarios", "two scenarios have the same name")
+    engine = _engine(args)
+    plan_runs(spec)  # every point resolved and keyed before anything starts
+    try:
+        outcome = run_study(spec, out, engine, args.keep)
+    except KeyboardInterrupt:
+        print(f"study interrupted; finished runs are kept in {out}: run it again to resume")
+        return 130
+    print(
+        f"{outcome.finished} runs finished, {outcome.skipped} already done, "
+        f"{len(outcome.failed)} failed; wall {outcome.wall_time_s:.1f} s; "
+        f"results in {out / 'results.csv'}, report in {out / 'report.md'}"
+    )
+    return 1 if outcome.failed else 0
+
+
+def _check_scenarios(spec) -> dict[str, str]:
+    """Every resolved scenario's files (plans, mesh, sky) checked; {reference: name}."""
+    from mission.studies.spec import validate_points
+
+    resolved = validate_points(spec)
+    for scenario in resolved.values():
+        preflight(scenario)
+    return {reference: resolved[(reference, 0)].name for reference in spec.scenarios}
+
+
+def _engine(args: argparse.Namespace):
+    if args.engine == "ray":
+        from mission.studies.ray_engine import RayEngine, require_ray
+
+        require_ray()
+        return RayEngine(args.address, args.jobs)
+    if args.address is not None:
+        raise InputError("command line", "--address", "is for --engine ray")
+    from mission.studies.local_engine import LocalEngine
+
+    return LocalEngine(args.jobs or os.cpu_count() or 1)
