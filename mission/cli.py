@@ -200,6 +200,13 @@ def _add_study_parser(commands) -> None:
         "--out", type=Path, metavar="DIR", help="where it goes (default results/NAME; resumable)"
     )
     study.add_argument(
+        "--runs",
+        type=Path,
+        metavar="DIR",
+        help="the runs' folders (default DIR/runs); studies that share one make a run they "
+        "have in common once",
+    )
+    study.add_argument(
         "--keep",
         choices=["all", "logs", "summary"],
         default="all",

@@ -42,7 +42,7 @@ def batch(args: argparse.Namespace) -> int:
         points=(Point(()),),
         tables=("table3",),
     )
-    args.engine, args.address, args.keep = "local", None, "all"
+    args.engine, args.address, args.keep, args.runs = "local", None, "all", None
     status = _run(spec, args.out, args)
     if (args.out / "table.md").is_file():
         print((args.out / "table.md").read_text(), end="")
@@ -57,13 +57,15 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
     if jobs is not None and not 1 <= jobs <= MAX_JOBS:
         raise InputError("command line", "--jobs", f"must be in [1, {MAX_JOBS}], got {jobs}")
     check_output_dir(out, "--out")
+    if args.runs is not None:
+        check_output_dir(args.runs, "--runs")
     names = _check_scenarios(spec)
     if len(set(names.values())) != len(names):
         raise InputError(str(spec.source), "scenarios", "two scenarios have the same name")
     engine = _engine(args)
     plan_runs(spec)  # every point resolved and keyed before anything starts
     try:
-        outcome = run_study(spec, out, engine, args.keep)
+        outcome = run_study(spec, out, engine, args.keep, runs_dir=args.runs)
     except KeyboardInterrupt:
         print(f"study interrupted; finished runs are kept in {out}: run it again to resume")
         return 130

@@ -58,10 +58,13 @@ def run_study(
     engine: Engine,
     keep: Keep = "all",
     progress: TextIO = sys.stderr,
+    runs_dir: Path | None = None,
 ) -> StudyOutcome:
-    """Run what is not finished yet and write results.csv and report.md."""
+    """Run what is not finished yet and write results.csv and report.md. ``runs_dir``
+    (default ``OUT/runs``) may be shared between studies: a run's folder is named by its key,
+    so a run that two studies hold in common is made once."""
     runs = plan_runs(spec)
-    runs_dir = out_dir / "runs"
+    runs_dir = runs_dir or out_dir / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)
     summaries: dict[StudyRun, dict[str, Any]] = {}
     for run in runs:
