@@ -65,6 +65,7 @@ def run_study(
     so a run that two studies hold in common is made once."""
     runs = plan_runs(spec)
     runs_dir = runs_dir or out_dir / "runs"
+    out_dir.mkdir(parents=True, exist_ok=True)
     runs_dir.mkdir(parents=True, exist_ok=True)
     summaries: dict[StudyRun, dict[str, Any]] = {}
     for run in runs:
