@@ -1,0 +1,125 @@
+"""The engines with real runs: the local engine and a two-node Ray cluster on this machine
+give the same results, spread over both nodes; a cancelled study leaves no process."""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mission.studies.local_engine import LocalEngine
+from mission.studies.spec import load_study
+from mission.studies.study import run_study
+from tests.processes import ROOT
+
+# what differs from run to run of the same lockstep mission: timings and where it ran
+_TIMING = {"wall_time_s", "realtime_factor", "mpc_solve_ms.median", "mpc_solve_ms.p95", "node"}
+
+SMALL_STUDY = """
+name: small
+scenarios: [along]
+methods: [ac, nac]
+seeds: 2
+points:
+  - {run.timeout_s: 15}
+"""
+
+
+def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:
+    return {(r["method"], r["seed"]): r for r in csv.DictReader(path.open())}
+
+
+def _study(tmp_path: Path, text: str = SMALL_STUDY):
+    path = tmp_path / "small.yaml"
+    path.write_text(text)
+    return load_study(path)
+
+
+@pytest.mark.slow
+def test_a_two_node_ray_cluster_gives_the_local_engines_results(tmp_path):
+    ray = pytest.importorskip("ray")
+    from ray.cluster_utils import Cluster
+
+    from mission.studies.ray_engine import RayEngine
+
+    spec = _study(tmp_path)
+    run_study(spec, tmp_path / "local", LocalEngine(2), progress=io.StringIO())
+    cluster = Cluster(
+        initialize_head=True,
+        head_node_args={"num_cpus": 1, "include_dashboard": False},
+    )
+    cluster.add_node(num_cpus=1)
+    try:
+        ray.init(address=cluster.address, log_to_driver=False)
+        outcome = run_study(
+            spec, tmp_path / "ray", RayEngine(cluster.address, None), progress=io.StringIO()
+        )
+    finally:
+        ray.shutdown()
+        cluster.shutdown()
+    assert outcome.failed == [] and outcome.finished == 4
+    local, remote = (
+        _rows(tmp_path / "local" / "results.csv"),
+        _rows(tmp_path / "ray" / "results.csv"),
+    )
+    assert local.keys() == remote.keys()
+    for key, row in local.items():
+        same = {c: v for c, v in row.items() if c not in _TIMING}
+        assert same == {c: v for c, v in remote[key].items() if c not in _TIMING}, key
+    assert len({row["node"] for row in remote.values()}) == 2  # both nodes ran some
+    run = next((tmp_path / "ray" / "runs").iterdir())  # the folder came back to the driver
+    assert {"summary.json", "gcs.tlog", "records.jsonl", "scenario.yaml"} <= {
+        p.name for p in run.iterdir()
+    }
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ["local", "ray"])
+def test_ctrl_c_cancels_a_study_and_leaves_no_process(tmp_path, engine):
+    if engine == "ray":
+        pytest.importorskip("ray")
+    path = tmp_path / "long.yaml"
+    path.write_text(SMALL_STUDY.replace("run.timeout_s: 15", "run.timeout_s: 600"))
+    marker = "mission-study-" if engine == "ray" else str(tmp_path)
+    before = _ray_processes()
+    study = subprocess.Popen(
+        [sys.executable, "-m", "mission", "study", str(path), "--engine", engine,
+         "--jobs", "2", "--out", str(tmp_path / "out")],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and not _running(marker):
+            time.sleep(0.2)
+        assert _running(marker), "a run got going"
+        time.sleep(1.0)
+        study.send_signal(signal.SIGINT)
+        stdout, stderr = study.communicate(timeout=90)
+    finally:
+        if study.poll() is None:
+            study.kill()
+    assert study.returncode == 130, stderr
+    assert "run it again to resume" in stdout
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and (_running(marker) or _ray_processes() > before):
+        time.sleep(0.5)
+    assert _running(marker) == [] and _ray_processes() <= before
+    assert not list((tmp_path / "out").glob("runs/*/summary.json"))
+
+
+def _running(marker: str) -> list[str]:
+    """Processes of a run whose command line holds ``marker``."""
+    found = subprocess.run(["pgrep", "-f", "--", marker], capture_output=True, text=True)
+    return [p for p in found.stdout.split() if int(p) != os.getpid()]
+
+
+def _ray_processes() -> int:
+    found = subprocess.run(["pgrep", "-c", "-f", "raylet|gcs_server"], capture_output=True)
+    return int(found.stdout.strip() or 0)

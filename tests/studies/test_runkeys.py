@@ -1,0 +1,43 @@
+"""A run's key: what determines its results, and nothing else."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+from mission.config.scenario import embedded_scenarios_dir
+from mission.studies.runkeys import code_version, resolved_key, study_runs
+from mission.studies.spec import Point, StudySpec
+
+
+def _spec(points: tuple[Point, ...] | None = None) -> StudySpec:
+    points = points or (Point(()),)
+    return StudySpec("s", "", Path("s.yaml"), ("along",), ("ac", "nac"), (0, 1), points, ())
+
+
+def test_keys_differ_by_method_seed_and_override_and_not_by_a_default_restated():
+    points = (Point(()), Point((("fusion.rho_threshold", 0.5),)), Point((("map.eta", 0.3),)))
+    runs = study_runs(_spec(points=points), {"along": "along"}, "code")
+    keys = {(r.point, r.method, r.seed): r.key for r in runs}
+    assert len(set(keys.values())) == 8  # points 0 and 2 are the same scenario
+    assert all(keys[(0, m, s)] == keys[(2, m, s)] for m in ("ac", "nac") for s in (0, 1))
+    assert runs[0].folder == f"along-ac-0-{runs[0].key[:10]}"
+    other_code = study_runs(_spec(), {"along": "along"}, "changed")
+    assert other_code[0].key != runs[0].key
+
+
+def test_a_key_follows_the_contents_of_the_plan_files_not_their_path(tmp_path):
+    plans = embedded_scenarios_dir() / "plans" / "bridge"
+    for name in ("a", "b"):
+        shutil.copytree(plans, tmp_path / name / "plans")
+        (tmp_path / name / "s.yaml").write_text("extends: along\ntask: {waypoints_dir: plans}\n")
+    a, b = (str(tmp_path / n / "s.yaml") for n in "ab")
+    assert resolved_key(a, Point(())) == resolved_key(b, Point(()))
+    work = tmp_path / "b" / "plans" / "work.waypoints"
+    work.write_text(work.read_text().replace("7.0", "7.5", 1) + "\n")
+    assert resolved_key(a, Point(())) != resolved_key(b, Point(()))
+    assert resolved_key(a, Point(())) == resolved_key("along", Point(()))
+
+
+def test_the_code_version_is_a_stable_digest():
+    assert code_version() == code_version() and len(code_version()) == 64

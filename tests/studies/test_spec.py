@@ -1,0 +1,118 @@
+"""Study files: what they expand to, and one line naming the culprit for each bad one."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from mission.config.errors import InputError
+from mission.studies.spec import load_study
+
+
+def _write(tmp_path: Path, text: str, name: str = "study.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_points_are_each_listed_point_crossed_with_the_grid_in_order(tmp_path):
+    spec = load_study(
+        _write(
+            tmp_path,
+            """
+            scenarios: [along]
+            seeds: {start: 5, count: 3}
+            grid:
+              fusion.rho_threshold: [0.0, 0.5]
+            points:
+              - {}
+              - {fusion.agreement: paper}
+            """,
+        )
+    )
+    assert spec.name == "study" and spec.methods == ("ac", "nac") and spec.seeds == (5, 6, 7)
+    assert [p.as_dict() for p in spec.points] == [
+        {"fusion.rho_threshold": 0.0},
+        {"fusion.rho_threshold": 0.5},
+        {"fusion.agreement": "paper", "fusion.rho_threshold": 0.0},
+        {"fusion.agreement": "paper", "fusion.rho_threshold": 0.5},
+    ]
+    assert spec.swept_keys == ["fusion.rho_threshold", "fusion.agreement"]
+    assert spec.size == 1 * 4 * 2 * 3
+
+
+def test_a_scenario_path_is_relative_to_the_study_file(tmp_path):
+    (tmp_path / "sub").mkdir()
+    _write(tmp_path / "sub", "extends: along\nname: mine\n", "mine.yaml")
+    spec = load_study(_write(tmp_path, "scenarios: [sub/mine.yaml, wall]\nseeds: [3]\n"))
+    assert spec.scenarios == (str((tmp_path / "sub" / "mine.yaml").resolve()), "wall")
+
+
+def test_every_shipped_study_is_valid():
+    root = Path(__file__).resolve().parents[2] / "studies"
+    names = sorted(p.stem for p in root.glob("*.yaml"))
+    assert {"smoke", "table3", "fusion-leakage", "work-speed"} <= set(names)
+    for path in root.glob("*.yaml"):
+        spec = load_study(path)
+        assert spec.name == path.stem
+        if path.stem != "smoke":  # the studies of the report: at least 15 paired seeds
+            assert len(spec.seeds) >= 15 and set(spec.methods) == {"ac", "nac"}
+
+
+BAD = [
+    ("scenarios: [along]\nsedes: 3\n", "sedes: unknown key"),
+    ("seeds: 3\n", "scenarios: must be a non-empty list"),
+    ("scenarios: [nowhere]\n", "scenarios[0]: no such scenario"),
+    ("scenarios: [along]\nmethods: [ac, xyz]\n", "methods: 'xyz' is not one of ac, nac"),
+    ("scenarios: [along]\nseeds: -1\n", "seeds: names no seed"),
+    ("scenarios: [along]\nseeds: [1, 1]\n", "seeds: a seed appears twice"),
+    ("scenarios: [along]\nseeds: [1.5]\n", "seeds: 1.5 is not a seed"),
+    ("scenarios: [along]\nseeds: {start: 0}\n", "seeds: must be a count"),
+    ("scenarios: [along]\ngrid: {fusion.rho_threshold: 0.5}\n", "grid.fusion.rho_threshold: must"),
+    ("scenarios: [along]\npoints: [{}, {}]\n", "points: the same point appears twice"),
+    ("scenarios: [along]\npoints: [3]\n", "points[0]: must map dotted keys"),
+    (
+        "scenarios: [along]\ngrid: {map.eta: [0.1]}\npoints: [{map.eta: 0.2}]\n",
+        "points[0].map.eta: is also a grid key",
+    ),
+    (
+        "scenarios: [along]\npoints: [{fusion.rho_thresold: 0.5}]\n",
+        "point 0 (fusion.rho_thresold=0.5): fusion.rho_thresold: unknown key",
+    ),
+    (
+        "scenarios: [along]\ngrid: {fusion.rho_threshold: [0.0, 2.0]}\n",
+        "point 1 (fusion.rho_threshold=2.0): fusion.rho_threshold: must be in [-1, 1]",
+    ),
+    (
+        "scenarios: [along]\npoints: [{fusion.agreement: most}]\n",
+        "point 0 (fusion.agreement=most): fusion.agreement:",
+    ),
+    (
+        "scenarios: [along]\npoints: [{fusion: 1, fusion.eta: 2}]\n",
+        "point 0: fusion.eta: fusion is set as a value and as a mapping",
+    ),
+    ("scenarios: [along]\ntables: [table9]\n", "tables: 'table9' is not one of table3"),
+    (
+        "scenarios: [along]\ntables: [table3]\ngrid: {map.eta: [0.1, 0.2]}\n",
+        "tables: Table 3 is for a study of one point",
+    ),
+    ("name: ../up\nscenarios: [along]\n", "name: must be a plain folder name"),
+    ("[1, 2]\n", "the file must hold a mapping"),
+]
+
+
+@pytest.mark.parametrize(("text", "expected"), BAD, ids=[b[1][:40] for b in BAD])
+def test_a_bad_study_file_is_one_line_naming_the_file_and_the_culprit(tmp_path, text, expected):
+    path = _write(tmp_path, text)
+    with pytest.raises(InputError) as caught:
+        load_study(path)
+    message = str(caught.value)
+    assert "\n" not in message and message.startswith(str(path)), message
+    assert expected in message, message
+
+
+def test_a_missing_study_file_is_named(tmp_path):
+    with pytest.raises(InputError, match="no such study file"):
+        load_study(tmp_path / "nope.yaml")
