@@ -93,9 +93,7 @@ def load_study(path: Path) -> StudySpec:
     listed = data.get("scenarios")
     if not isinstance(listed, list) or not listed:
         raise InputError(source, "scenarios", "must be a non-empty list of names or paths")
-    scenarios = tuple(
-        _listed_scenario(path, reference, i) for i, reference in enumerate(listed)
-    )
+    scenarios = tuple(_listed_scenario(path, reference, i) for i, reference in enumerate(listed))
     methods_given = data.get("methods", list(METHODS))
     if not isinstance(methods_given, list) or not methods_given:
         raise InputError(source, "methods", "must be a non-empty list (ac, nac)")
