@@ -322,6 +322,40 @@ CASES = [
         lambda t: ["analyze", str(_tlog(t, b"x", summary="[1, 2]"))],
         ["summary.json", "not a JSON object"],
     ),
+    # --- mission study -------------------------------------------------------------------
+    ("study-missing", lambda t: ["study", str(t / "none.yaml")], ["none.yaml", "no such study"]),
+    (
+        "study-unknown-key",
+        lambda t: ["study", str(_study(t, "points: [{fusion.rho_thresold: 0.5}]\n"))],
+        ["s.yaml", "fusion.rho_thresold", "unknown key"],
+    ),
+    (
+        "study-bad-value",
+        lambda t: ["study", str(_study(t, "grid: {map.eta: [0.3, 1.5]}\n"))],
+        ["s.yaml", "point 1", "map.eta"],
+    ),
+    (
+        "study-bad-plan",
+        lambda t: ["study", str(_study(t, f"points: [{{task.waypoints_dir: {t}}}]\n"))],
+        ["work.waypoints"],
+    ),
+    ("study-jobs", lambda t: ["study", str(_study(t)), "--jobs", "0"], ["--jobs"]),
+    (
+        "study-address-local",
+        lambda t: ["study", str(_study(t)), "--address", "10.0.0.1:6379"],
+        ["--address", "--engine ray"],
+    ),
+    ("study-keep", lambda t: ["study", str(_study(t)), "--keep", "some"], ["--keep"]),
+    (
+        "study-out-is-file",
+        lambda t: ["study", str(_study(t)), "--out", str(_file(t))],
+        ["--out", "is a file"],
+    ),
+    (
+        "study-runs-under-file",
+        lambda t: ["study", str(_study(t)), "--runs", str(_file(t) / "r")],
+        ["--runs", "under"],
+    ),
     # --- signing keys ------------------------------------------------------------------
     ("key-missing", lambda t: [*RUN, "--signing-key", str(t / "none.key")], ["none.key"]),
     (
@@ -340,6 +374,12 @@ CASES = [
         ["link.key"],
     ),
 ]
+
+
+def _study(tmp: Path, body: str = "") -> Path:
+    path = tmp / "s.yaml"
+    path.write_text(f"scenarios: [along]\nseeds: 1\n{body}")
+    return path
 
 
 def _raw(tmp: Path, text: str) -> Path:
@@ -408,7 +448,8 @@ def _entry(case: str):
 def test_the_table_covers_every_kind_of_input():
     assert len(CASES) >= 60
     kinds = {c[0].split("-")[0] for c in CASES}
-    assert {"yaml", "wpl", "mesh", "run", "key", "gcs", "vehicle", "analyze", "plan"} <= kinds
+    kinds_wanted = {"yaml", "wpl", "mesh", "run", "key", "gcs", "vehicle", "analyze", "plan"}
+    assert kinds_wanted | {"study"} <= kinds
 
 
 @pytest.mark.parametrize(("case", "argv", "expected"), CASES, ids=[c[0] for c in CASES])

@@ -139,3 +139,20 @@ def _tree(root: Path) -> dict[str, bytes]:
     return {
         str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()
     }
+
+
+def test_without_ray_the_ray_engine_says_in_one_line_how_to_install_it(
+    tmp_path, monkeypatch, capsys
+):
+    import sys
+
+    import mission.cli
+
+    monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` fails as if not installed
+    monkeypatch.chdir(tmp_path)
+    study = tmp_path / "s.yaml"
+    study.write_text("scenarios: [along]\nseeds: 1\n")
+    status = mission.cli.entry_point(["study", str(study), "--engine", "ray"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "pip install -e '.[ray]'" in err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
