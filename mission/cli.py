@@ -96,7 +96,7 @@ def _add_bench_parser(commands) -> None:
     bench.add_argument(
         "--only",
         action="append",
-        choices=["world", "vehicle", "gcs", "run"],
+        choices=["world", "vehicle", "gcs", "run", "study"],
         help="run only this group (repeatable)",
     )
 

@@ -11,24 +11,14 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
-
-
-@dataclass(frozen=True)
-class BenchResult:
-    """One measured figure and its target."""
-
-    name: str
-    value: float
-    unit: str
-    target: str
-    ok: bool | None  # None: a reference figure with no target
+from mission.runs.bench_result import BenchResult
+from mission.runs.bench_study import bench_studies
 
 
 def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
@@ -327,6 +317,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "vehicle": bench_vehicle,
     "gcs": bench_ground_station,
     "run": bench_runs,
+    "study": bench_studies,
 }
 
 

@@ -96,3 +96,14 @@ def test_every_invocation_starts_with_the_machines_speed_without_a_verdict(monke
     table = bench.format_table(rows).splitlines()
     assert table[1].split()[-2:] == ["reference", "-"]
     assert table[2].split()[-1] == "yes"
+
+
+def test_the_study_bench_reports_runs_per_hour_and_the_ray_to_local_ratio(monkeypatch):
+    from mission.runs import bench_study
+
+    walls = iter([72.0, 75.6])  # local, then Ray
+    monkeypatch.setattr(bench_study, "_wall", lambda spec, out, engine: next(walls))
+    rows = {r.name: r for r in bench_study.bench_studies()}
+    assert rows["study_runs_per_hour"].value == pytest.approx(20 / 72.0 * 3600)
+    ratio = rows["ray_over_local_wall_ratio"]
+    assert ratio.value == pytest.approx(1.05) and ratio.ok
