@@ -93,6 +93,7 @@ def test_ctrl_c_cancels_a_study_and_leaves_no_process(tmp_path, engine):
         [sys.executable, "-m", "mission", "study", str(path), "--engine", engine,
          "--jobs", "2", "--out", str(tmp_path / "out")],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+        preexec_fn=_ignore_sigint,  # as a background job starts it: Ctrl-C must still work
     )  # fmt: skip
     try:
         deadline = time.monotonic() + 120
@@ -112,6 +113,10 @@ def test_ctrl_c_cancels_a_study_and_leaves_no_process(tmp_path, engine):
         time.sleep(0.5)
     assert _running(marker) == [] and _ray_processes() <= before
     assert not list((tmp_path / "out").glob("runs/*/summary.json"))
+
+
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _running(marker: str) -> list[str]:
