@@ -220,7 +220,16 @@ def analyze(args: argparse.Namespace) -> int:
         raise InputError(str(tlog), "", "is empty")
     summary_path = tlog.parent / "summary.json"
     previous = _previous_summary(summary_path)
-    scenario_name = args.scenario or previous.get("scenario_source") or previous.get("scenario")
+    beside = tlog.parent / "scenario.yaml"  # a study's run carries the scenario it ran
+    source = previous.get("scenario_source")
+    if source is not None and not Path(source).is_file():
+        source = None  # resolved on another machine (a Ray node's temporary folder)
+    scenario_name = (
+        args.scenario
+        or (str(beside) if beside.is_file() else None)
+        or source
+        or previous.get("scenario")
+    )
     if scenario_name is None:
         raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
     scenario = load_scenario(scenario_name)

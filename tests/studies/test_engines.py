@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import os
 import signal
 import subprocess
@@ -14,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+import mission.cli
 from mission.studies.local_engine import LocalEngine
 from mission.studies.spec import load_study
 from mission.studies.study import run_study
@@ -43,7 +45,7 @@ def _study(tmp_path: Path, text: str = SMALL_STUDY):
 
 
 @pytest.mark.slow
-def test_a_two_node_ray_cluster_gives_the_local_engines_results(tmp_path):
+def test_a_two_node_ray_cluster_gives_the_local_engines_results(tmp_path, capsys):
     ray = pytest.importorskip("ray")
     from ray.cluster_utils import Cluster
 
@@ -78,6 +80,12 @@ def test_a_two_node_ray_cluster_gives_the_local_engines_results(tmp_path):
     assert {"summary.json", "gcs.tlog", "records.jsonl", "scenario.yaml"} <= {
         p.name for p in run.iterdir()
     }
+    # its summary names the node's (deleted) scenario file; analyze reads the one beside it
+    summary = json.loads((run / "summary.json").read_text())
+    assert not Path(summary["scenario_source"]).exists()
+    assert mission.cli.entry_point(["analyze", str(run)]) == 0
+    metrics = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert metrics == {k: summary[k] for k in metrics}
 
 
 @pytest.mark.slow
