@@ -51,8 +51,9 @@ def batch(args: argparse.Namespace) -> int:
 
 
 def _run(spec, out: Path, args: argparse.Namespace) -> int:
-    """Check everything, then run the study on the chosen engine."""
-    from mission.studies.study import plan_runs, run_study
+    """Check everything, then run the study on the chosen engine (which keys every run
+    before it starts any)."""
+    from mission.studies.study import run_study
 
     jobs = args.jobs
     if jobs is not None and not 1 <= jobs <= MAX_JOBS:
@@ -64,7 +65,6 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
     if len(set(names.values())) != len(names):
         raise InputError(str(spec.source), "scenarios", "two scenarios have the same name")
     engine = _engine(args)
-    plan_runs(spec)  # every point resolved and keyed before anything starts
     # Ctrl-C and SIGTERM stop the study, even where it was started with SIGINT ignored (in the
     # background): then `kill -INT` cancels it as Ctrl-C would.
     previous = {

@@ -190,3 +190,19 @@ def test_the_ground_station_refuses_a_world_with_zones(along, along_world, tmp_p
         GroundStation(along_world, _config(along, tmp_path))
     with pytest.raises(TypeError, match="KnownWorld"):
         build_models(along_world, _waypoints(read_plan(along)), True, 0)
+
+
+@pytest.mark.parametrize("escape_starts", [True, False])
+def test_escape_starts_are_asked_for_where_g_has_risen_unless_switched_off(escape_starts):
+    from ground_station.plan import support_request
+    from ground_station.work_mpc import WorkPrediction
+    from mission.config.scenario import load_scenario
+
+    scenario = load_scenario("along", {"control.escape_starts": escape_starts})
+    known = KnownWorld(scenario)
+    models, state = build_models(known, _waypoints(read_plan(scenario)), True, 0)
+    horizon = scenario.control.horizon_steps
+    work = WorkPrediction(np.repeat(state.xhat[None], horizon + 1, 0), np.zeros(horizon + 1, int))
+    assert not support_request(state, "support-1", work, models).escape  # G as predicted
+    models.g.values += 2.0  # GNSS worse everywhere than the prior map said
+    assert support_request(state, "support-1", work, models).escape is escape_starts
