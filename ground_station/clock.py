@@ -6,10 +6,15 @@ every vehicle, and ends when each has sent its step marker (its own SYSTEM_TIME 
 step's telemetry). A vehicle whose marker is late gets its cycle's datagram again (the tick
 and the commands before it, encoded afresh: a signed link refuses replays); one still missing
 after a short grace is not waited for, so a dead vehicle does not slow the run.
+
+In real time the cycles keep to a fixed schedule: cycle n runs at n * t_cont of simulated time
+after the flight starts, which is ``n * t_cont / speedup`` wall seconds, however long the
+cycles before it took (a cycle that overran is not made up: the next due one runs).
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -63,7 +68,29 @@ class StationClock:
         self.run = run
         self.step_s = step_s
         self.speedup = speedup  # None: lockstep
-        self.time_s = 0.0
+        self.time_s = 0.0  # the current step's (cycle's) time; 0 until the flight starts
+        self.flight_origin_wall: float | None = None  # real time: when the flight started
+
+    def begin_flight(self) -> None:
+        """Real time: the flight starts now (simulated time 0 of the schedule)."""
+        if self.speedup is not None:
+            self.flight_origin_wall = time.monotonic()
+
+    def now_s(self) -> float:
+        """Simulated time now: the step's in lockstep; in real time the wall clock's since the
+        flight started, scaled (the step's before it)."""
+        if self.speedup is None or self.flight_origin_wall is None:
+            return self.time_s
+        return (time.monotonic() - self.flight_origin_wall) * self.speedup
+
+    def now_usec(self) -> int:
+        """:meth:`now_s` as UNIX microseconds from the scenario's epoch (what is received is
+        logged at this time)."""
+        return round((self.run.epoch_unix_s + self.now_s()) * 1e6)
+
+    def sample_time_s(self, time_usec: int, offset_s: float) -> float:
+        """A vehicle's time stamp (UNIX microseconds of its own clock) on this clock."""
+        return time_usec / 1e6 - self.run.epoch_unix_s - offset_s
 
     @property
     def time_usec(self) -> int:
@@ -98,9 +125,7 @@ def await_step(
     again to a vehicle that stays behind. Real time: let the step's wall time pass."""
     tick = pending.tick
     if tick is None:
-        assert clock.speedup is not None
-        links.pump(pending.step_s / clock.speedup)
-        clock.time_s += pending.step_s
+        _await_schedule(links, clock, pending)
         return
     target_ms = int(tick.time_boot_ms)
     views = links.views.values()
@@ -125,3 +150,20 @@ def await_step(
     for view in views:
         view.late = view.step_ms < target_ms
         links.stats["late_steps"] += int(view.late and not view.lost)
+
+
+def _await_schedule(links: SteppingLinks, clock: StationClock, pending: PendingStep) -> None:
+    """Real time: receive until the next cycle's time on the schedule, or the latest one due
+    when the cycles are behind it."""
+    assert clock.speedup is not None
+    if clock.flight_origin_wall is None:
+        clock.begin_flight()
+    assert clock.flight_origin_wall is not None
+    step_wall = pending.step_s / clock.speedup
+    due = max(
+        clock.time_s + pending.step_s,
+        math.floor(clock.now_s() / pending.step_s + 1e-9) * pending.step_s,
+    )
+    steps = round(due / pending.step_s)
+    links.pump(max(0.0, clock.flight_origin_wall + steps * step_wall - time.monotonic()))
+    clock.time_s = steps * pending.step_s

@@ -1,6 +1,7 @@
 """The control cycle of the paper's Section 4, run every t_cont: five steps, one call each.
 
-1. localize: each support's GNSS fix p_n and camera observation r_n, with covariances;
+1. localize: each support's GNSS fix p_n and camera observation r_n (brought to the cycle's
+   time, :mod:`~ground_station.align`), with covariances;
 2. fuse: selective fusion for the work UAV's xhat, feedback for each support's yhat_n;
 3. check arrival at the current work waypoint (|w_k - xhat| < 0.1 m advances k);
 4. learn: G updated around each yhat_n with the GNSS error seen there (AC only);
@@ -21,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ground_station.align import align
 from ground_station.arrival import check_arrival
 from ground_station.fusion import FusionResult, SupportMeasurement, fuse
 from ground_station.localizability import learn
@@ -72,7 +74,7 @@ def control_cycle(
     """The paper's five steps for this cycle's reports; updates ``state`` in place."""
     start = time.perf_counter()
     control = models.scenario.control
-    measurements = localize(reports, models.world)  # 1
+    measurements = localize(align(reports, state, control.t_cont_s), models.world)  # 1
     fusion, betas = fuse(state, measurements, models.scenario.fusion, models.rng)  # 2
     arrived = check_arrival(state, models.work_waypoints, control.arrival_tol_m)  # 3
     updated = learn(models.g, measurements, state.yhat)  # 4

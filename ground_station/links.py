@@ -3,6 +3,10 @@ every packet in and out written to the tlog at the clock's simulated time.
 
 Messages are accepted only from the vehicles' own addresses. SIM_STATE (the simulator's truth)
 goes to the tlog for analysis and is not kept: nothing here or above can read it.
+
+A measurement's time is its own stamp (``time_usec``), mapped onto the ground station's clock
+with the vehicle's clock offset (:mod:`~ground_station.clock_sync`); its age at a cycle is the
+cycle's time minus that. In lockstep only the step's own measurements are used: age zero.
 """
 
 from __future__ import annotations
@@ -15,12 +19,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ground_station.clock import StationClock
+from ground_station.clock_sync import ClockOffsets
 from ground_station.outgoing import (
     GCS_COMPONENT_ID,
     GCS_SYSTEM_ID,
     GUIDED_AND_ARMED,
     command_long,
     statustext,
+    timesync_request,
 )
 from ground_station.tlog import TlogWriter
 from mission.link.impairment import LinkSettings
@@ -28,6 +34,19 @@ from mission.link.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEnd
 from mission.link.vehicle_identity import VehicleIdentity
 
 TRUTH_KINDS = frozenset({"SIM_STATE"})  # logged, never kept
+MAX_AGE_STEPS = 2.0  # real time: a measurement older than this many cycles is not used
+
+
+@dataclass(frozen=True)
+class SupportSample:
+    """A support's latest GNSS fix and camera observation for a cycle, with their ages in
+    simulated seconds at the cycle's time (None where missing or too old)."""
+
+    name: str
+    gps: Any | None
+    target: Any | None
+    gps_age_s: float = 0.0
+    target_age_s: float = 0.0
 
 
 class StationError(RuntimeError):
@@ -77,6 +96,7 @@ class VehicleLinks:
         }
         self.by_system = {v.system_id: v for v in self.views.values()}
         self.stats = {"lost_in": 0, "tick_resends": 0, "late_steps": 0}
+        self.offsets = ClockOffsets()
         self._last_seq: dict[int, int] = {}
 
     # -- out --------------------------------------------------------------------------------
@@ -115,6 +135,11 @@ class VehicleLinks:
         """Send a COMMAND_LONG now."""
         self.send(command_long(view.system_id, command, params), view)
 
+    def sync_clocks(self) -> None:
+        """Real time: a TIMESYNC request to every vehicle, stamped with the time it leaves."""
+        for view in self.views.values():
+            self.send(timesync_request(round(self.clock.now_s() * 1e9)), view)
+
     def announce(self, text: str, to_stderr: bool = False) -> None:
         """A STATUSTEXT in the tlog (and on stderr for link events)."""
         if to_stderr:
@@ -130,9 +155,12 @@ class VehicleLinks:
         if view is None or sender != view.address:  # only our vehicles, from where they are
             self.endpoint.counters.reject("unknown sender")
             return
-        self.tlog.write(self.clock.time_usec, message.get_msgbuf())
+        self.tlog.write(self.clock.now_usec(), message.get_msgbuf())
         self._count_gap(view.system_id, message.get_seq())
         kind = message.get_type()
+        if kind == "TIMESYNC" and not self.clock.lockstep:
+            received_ns = round(self.clock.now_s() * 1e9)
+            self.offsets.observe(view.system_id, message.tc1, message.ts1, received_ns)
         if kind not in TRUTH_KINDS:
             view.latest[kind] = message
         view.heard_s = self.clock.time_s
@@ -176,13 +204,38 @@ class VehicleLinks:
             return None
         return message
 
-    def support_messages(self) -> list[tuple[str, Any | None, Any | None]]:
-        """(name, GPS_RAW_INT, LANDING_TARGET) of the step, for every support not lost."""
-        return [
-            (name, self.current(name, "GPS_RAW_INT"), self.current(name, "LANDING_TARGET"))
-            for name, view in self.views.items()
-            if name != "work" and not view.lost
-        ]
+    def age_s(self, name: str, message: Any | None) -> float | None:
+        """The age of a measurement at the current cycle (None: missing, too old, or its
+        vehicle's clock not known yet)."""
+        if message is None:
+            return None
+        if self.clock.lockstep:
+            return 0.0
+        offset = self.offsets.offset_s(self.views[name].system_id)
+        if offset is None:
+            return None
+        age = self.clock.time_s - self.clock.sample_time_s(int(message.time_usec), offset)
+        return age if age <= MAX_AGE_STEPS * self.clock.step_s else None
+
+    def support_samples(self) -> list[SupportSample]:
+        """Each support's GPS_RAW_INT and LANDING_TARGET for this cycle with their ages, for
+        every support not lost."""
+        samples = []
+        for name, view in self.views.items():
+            if name == "work" or view.lost:
+                continue
+            gps, target = self.current(name, "GPS_RAW_INT"), self.current(name, "LANDING_TARGET")
+            gps_age, target_age = self.age_s(name, gps), self.age_s(name, target)
+            samples.append(
+                SupportSample(
+                    name,
+                    gps if gps_age is not None else None,
+                    target if target_age is not None else None,
+                    gps_age or 0.0,
+                    target_age or 0.0,
+                )
+            )
+        return samples
 
     # -- who is there -----------------------------------------------------------------------
     def supervise(self, link_loss_s: float, rejoin_within_s: float) -> list[str]:

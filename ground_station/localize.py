@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -39,27 +39,49 @@ def relative_observation(message: Any | None) -> np.ndarray | None:
 
 @dataclass(frozen=True)
 class SupportReport:
-    """What one support reported this cycle: p_n and r_n (ENU; None where missing) and the
-    receiver's own accuracy as a covariance."""
+    """What one support reported this cycle: p_n and r_n (ENU; None where missing), the
+    receiver's own accuracy as a covariance, and how old each measurement is at the cycle's
+    time (simulated seconds; zero in lockstep)."""
 
     name: str
     fix: np.ndarray | None
     relative: np.ndarray | None
     reported: np.ndarray | None = None
+    fix_age_s: float = 0.0
+    relative_age_s: float = 0.0
 
 
-def reports_from_messages(
-    messages: Sequence[tuple[str, Any | None, Any | None]], frame: GeodeticFrame
-) -> list[SupportReport]:
-    """Each support's report from its (name, GPS_RAW_INT, LANDING_TARGET) of the step."""
+class Sample(Protocol):
+    """A support's messages for a cycle (:class:`ground_station.links.SupportSample`)."""
+
+    name: str
+    gps: Any | None
+    target: Any | None
+    gps_age_s: float
+    target_age_s: float
+
+
+def reports_from_messages(samples: Sequence[Sample], frame: GeodeticFrame) -> list[SupportReport]:
+    """Each support's report from its GPS_RAW_INT and LANDING_TARGET for the cycle."""
     reports = []
-    for name, gps, target in messages:
+    for sample in samples:
+        gps = sample.gps
         fix = gnss_fix(gps, frame)
         reported = None
         if fix is not None:
             h, v = max(gps.h_acc, 1) / 1000.0, max(gps.v_acc, 1) / 1000.0
             reported = np.diag([h * h / 2, h * h / 2, v * v])
-        reports.append(SupportReport(name, fix, relative_observation(target), reported))
+        relative = relative_observation(sample.target)
+        reports.append(
+            SupportReport(
+                sample.name,
+                fix,
+                relative,
+                reported,
+                sample.gps_age_s if fix is not None else 0.0,
+                sample.target_age_s if relative is not None else 0.0,
+            )
+        )
     return reports
 
 

@@ -27,8 +27,16 @@ class RunRecords:
         self._snapshots = out_dir / "g"
         self._snapshots.mkdir(exist_ok=True)
 
-    def cycle(self, state: StationState, output: CycleOutput, time_s: float) -> None:
-        """One line: the estimates, S, beta_n, arrival, G's update and each MPC's solve."""
+    def cycle(
+        self,
+        state: StationState,
+        output: CycleOutput,
+        time_s: float,
+        ages_ms: dict[str, list[float | None]] | None = None,
+    ) -> None:
+        """One line: the estimates, S, beta_n, arrival, G's update and each MPC's solve; in
+        real time also the age of each support's [GNSS fix, camera observation] used (ms;
+        None where missing). In lockstep every age is zero and the field is left out."""
         fusion = output.fusion
         record = {
             "t": round(time_s, 3),
@@ -48,6 +56,8 @@ class RunRecords:
             },
             "cycle_ms": round(output.cycle_ms, 3),
         }
+        if ages_ms is not None:
+            record["age_ms"] = ages_ms
         self._records.write(json.dumps(record) + "\n")
         self._records.flush()
 

@@ -18,7 +18,7 @@ from typing import Any
 from ground_station.clock import LockstepTiming, PendingStep, StationClock, await_step
 from ground_station.cycle import CycleDecision, CycleOutput, complete_cycle, control_cycle
 from ground_station.links import VehicleLinks
-from ground_station.localize import reports_from_messages
+from ground_station.localize import SupportReport, reports_from_messages
 from ground_station.models import Models, build_models, require_known_world
 from ground_station.outgoing import mission_set_current, position_target, vision_position_estimate
 from ground_station.preflight import arm_all, connect, upload_missions
@@ -120,13 +120,16 @@ class GroundStation:
 
     def _fly(self, models: Models, state: StationState) -> float | None:
         """Control cycles until the work UAV completes its task (its time) or the timeout."""
+        self.clock.begin_flight()
         pending = self._start_step(self.clock.next_step())
         self.links.flush_all()
         while pending is not None:
+            if not self.clock.lockstep:  # each vehicle's clock, for its measurements' ages
+                self.links.sync_clocks()
             await_step(self.links, self.clock, pending, self.timing)
             for name in self.links.supervise(self.config.link_loss_s, self.clock.step_s):
                 state.forget(name)
-            reports = reports_from_messages(self.links.support_messages(), self.frame)
+            reports = reports_from_messages(self.links.support_samples(), self.frame)
             decision = control_cycle(state, reports, models)
             work_step = self._command_work(state, decision)  # it steps while
             output = complete_cycle(state, decision, models)  # the supports' MPCs are solved
@@ -135,7 +138,7 @@ class GroundStation:
             # the next tick goes out now: the vehicles step while this cycle is written down
             pending = None if state.completed else self._start_step(work_step, work_ticked=True)
             self.links.flush_all()
-            self._record(models, state, output, cycle_time_s)
+            self._record(models, state, output, cycle_time_s, self._ages_ms(reports))
             if state.completed:
                 self.links.announce(f"Mission complete at {self.clock.time_s:.1f} s")
                 return self.clock.time_s
@@ -179,10 +182,28 @@ class GroundStation:
             self.links.queue_for(estimate, view)
             self.links.queue_for(position_target(target, time_ms, view.system_id), view)
 
+    def _ages_ms(self, reports: list[SupportReport]) -> dict[str, list[float | None]] | None:
+        """Real time: each support's [GNSS fix, camera observation] age in ms (None: not
+        used); lockstep: None (every measurement is the step's own)."""
+        if self.clock.lockstep:
+            return None
+        return {
+            r.name: [
+                None if r.fix is None else round(r.fix_age_s * 1000, 1),
+                None if r.relative is None else round(r.relative_age_s * 1000, 1),
+            ]
+            for r in reports
+        }
+
     def _record(
-        self, models: Models, state: StationState, output: CycleOutput, time_s: float
+        self,
+        models: Models,
+        state: StationState,
+        output: CycleOutput,
+        time_s: float,
+        ages_ms: dict[str, list[float | None]] | None,
     ) -> None:
-        self.records.cycle(state, output, time_s)
+        self.records.cycle(state, output, time_s, ages_ms)
         self.cycles += 1
         if self.cycles % SNAPSHOT_EVERY == 0:
             self.records.snapshot(models.g, f"{self.cycles:05d}")

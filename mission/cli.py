@@ -170,6 +170,12 @@ def _add_batch_parser(commands) -> None:
     batch.add_argument(
         "--out", type=Path, default=Path("logs/batch"), help="default logs/batch (resumable)"
     )
+    batch.add_argument(
+        "--realtime", action="store_true", help="every run in real time instead of lockstep"
+    )
+    batch.add_argument(
+        "--speedup", type=float, help="with --realtime: this many times faster (default 1)"
+    )
 
 
 def _add_study_parser(commands) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from mission.config.errors import InputError
 from mission.procs.outputs import check_output_dir
-from mission.subcommands import preflight
+from mission.subcommands import preflight, realtime_speedup
 
 MAX_JOBS = 256
 
@@ -42,6 +42,7 @@ def batch(args: argparse.Namespace) -> int:
         seeds=tuple(range(args.trials)),
         points=(Point(()),),
         tables=("table3",),
+        speedup=realtime_speedup(args),
     )
     args.engine, args.address, args.keep, args.runs = "local", None, "all", None
     status = _run(spec, args.out, args)

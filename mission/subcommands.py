@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
 
         die_with_parent()
     check_seed(args.seed)
-    speedup = _speedup(args)
+    speedup = realtime_speedup(args)
     scenario = load_scenario(args.scenario)
     preflight(scenario)
     stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _speedup(args: argparse.Namespace) -> float | None:
+def realtime_speedup(args: argparse.Namespace) -> float | None:
     """The real-time speed-up (None: lockstep); --speedup only with --realtime."""
     if not args.realtime:
         if args.speedup is not None:

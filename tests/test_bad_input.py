@@ -236,6 +236,8 @@ CASES = [
     ("run-observer", lambda t: [*RUN, "--observer", "qgc"], ["--observer"]),
     ("batch-trials", lambda t: ["batch", "--trials", "0"], ["--trials"]),
     ("batch-jobs", lambda t: ["batch", "--jobs", "0"], ["--jobs"]),
+    ("batch-speedup-alone", lambda t: ["batch", "--speedup", "10"], ["--speedup", "--realtime"]),
+    ("batch-speedup-zero", lambda t: ["batch", "--realtime", "--speedup", "0"], ["--speedup"]),
     ("gcs-waypoints-dir", lambda t: ["--waypoints", str(t / "none")], ["--waypoints"]),
     ("analyze-no-tlog", lambda t: ["analyze", str(_dir(t, "empty"))], ["no gcs.tlog"]),
     ("batch-methods", lambda t: ["batch", "--methods", "ac,best"], ["--methods"]),

@@ -7,9 +7,14 @@ Stepping lives in :class:`~vehicle_sim.vehicle.Vehicle`; this module only decide
   means "advance to T"; a vehicle started into a running mission takes up the clock from its
   first tick. With no tick for ``lockstep_timeout_wall_s`` the vehicle advances one
   step alone, so a lost packet cannot freeze it; before the first tick it only sends heartbeats.
-- real time: one step every ``t_cont / speedup`` wall seconds.
+- real time: one step every ``t_cont / speedup`` wall seconds from the process's start; the
+  vehicle's simulated clock is its own (as an autopilot's time since boot), and it answers
+  TIMESYNC with it so the ground station can map its time stamps onto its own clock.
 
-Each step ends with SYSTEM_TIME (the step marker the ground station waits for).
+Each step ends with SYSTEM_TIME (the step marker the ground station waits for). A support's
+camera sample of a step needs the work UAV's truth at the same physical time
+(:mod:`vehicle_sim.truth_link`); it is waited for briefly: in lockstep up to
+``truth_timeout_wall_s``, in real time up to one step's wall time (then interpolated).
 """
 
 from __future__ import annotations
@@ -24,6 +29,8 @@ import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
+
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import Address, UdpEndpoint
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
@@ -78,6 +85,7 @@ class VehicleServer:
         self._started = False
         self._last_tick_wall = 0.0
         self._origin_wall = 0.0
+        self._origin_unix = 0.0  # the same instant on the host's wall clock (truth channel)
         self._last_idle_heartbeat = -math.inf
         self._pending_deadline: float | None = None
         self._parent = os.getppid()
@@ -116,6 +124,7 @@ class VehicleServer:
         """Serve until stop() or a signal."""
         assert self.vehicle is not None
         self._origin_wall = time.monotonic()
+        self._origin_unix = time.time()
         sources: list[Any] = [self.endpoint]
         if self.truth_receiver is not None:
             sources.append(self.truth_receiver)
@@ -176,6 +185,9 @@ class VehicleServer:
             if self.clock.lockstep:
                 self._on_tick(message.time_boot_ms / 1000.0, now, sender)
             return
+        if message.get_type() == "TIMESYNC" and not self.clock.lockstep:
+            self._on_timesync(message, now)
+            return
         try:
             vehicle.handle(message, now)
         except Exception as error:  # a malformed message never kills the vehicle
@@ -200,6 +212,35 @@ class VehicleServer:
         self._requested_s = max(self._requested_s, time_s)
         self._started = True
         self._last_tick_wall = now
+
+    def _on_timesync(self, message: Any, now: float) -> None:
+        """Real time: answer a TIMESYNC request with this vehicle's clock now (not the last
+        step's time: the ground station's offset estimate needs the instant of the reply)."""
+        if message.tc1 != 0:
+            return
+        vehicle = self.vehicle
+        assert vehicle is not None
+        now_ns = round((now - self._origin_wall) * self.clock.speedup * 1e9)
+        vehicle.send(mavlink2.MAVLink_timesync_message(now_ns, message.ts1))
+
+    def _physical_usec(self) -> int:
+        """The physical time of the current step for the truth channel: simulated time in
+        lockstep, the host's wall clock at the step's nominal instant in real time."""
+        vehicle = self.vehicle
+        assert vehicle is not None
+        if self.clock.lockstep:
+            return round(vehicle.sim_time_s * 1e6)
+        step_wall = vehicle.step_s / self.clock.speedup
+        return round((self._origin_unix + vehicle.steps * step_wall) * 1e6)
+
+    def _truth_wait_wall_s(self) -> float:
+        """How long a support waits for the work UAV's truth of its step."""
+        vehicle = self.vehicle
+        assert vehicle is not None
+        timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
+        if self.clock.lockstep:
+            return timeout
+        return min(timeout, vehicle.step_s / self.clock.speedup)
 
     # -- stepping ---------------------------------------------------------------------------
     def _advance(self, now: float) -> None:
@@ -230,36 +271,33 @@ class VehicleServer:
         vehicle = self.vehicle
         assert vehicle is not None
         vehicle.step()
+        physical_usec = self._physical_usec()
         if self.truth_sender is not None:
-            self.truth_sender.publish(vehicle.kinematics.truth, vehicle.time_boot_ms)
+            self.truth_sender.publish(vehicle.kinematics.truth, physical_usec)
         if self.truth_receiver is None or not vehicle.sensor_due():
             self._publish_step(None)
             return True
         self.truth_receiver.drain()
-        truth = self.truth_receiver.exact(vehicle.time_boot_ms)
-        if (
-            truth is None
-            and self.clock.lockstep
-            and self.truth_receiver.may_still_come(vehicle.time_boot_ms)
-        ):
-            timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
-            self._pending_deadline = now + timeout
+        truth = self.truth_receiver.exact(physical_usec)
+        if truth is None and self.truth_receiver.may_still_come(physical_usec):
+            self._pending_deadline = now + self._truth_wait_wall_s()
             return False
         self._publish_step(
-            truth if truth is not None else self.truth_receiver.estimate(vehicle.time_boot_ms)
+            truth if truth is not None else self.truth_receiver.estimate(physical_usec)
         )
         return True
 
     def _finish_pending(self, now: float) -> bool:
         vehicle, receiver = self.vehicle, self.truth_receiver
         assert vehicle is not None and receiver is not None and self._pending_deadline is not None
-        truth = receiver.exact(vehicle.time_boot_ms)
+        physical_usec = self._physical_usec()
+        truth = receiver.exact(physical_usec)
         timed_out = now >= self._pending_deadline
-        if truth is None and not timed_out and receiver.may_still_come(vehicle.time_boot_ms):
+        if truth is None and not timed_out and receiver.may_still_come(physical_usec):
             return False
         if truth is None:  # a later truth came instead, or none in time
             self.stats.truth_waits_timed_out += int(timed_out)
-            truth = receiver.estimate(vehicle.time_boot_ms)
+            truth = receiver.estimate(physical_usec)
         self._pending_deadline = None
         self._publish_step(truth)
         return True
@@ -285,13 +323,15 @@ class VehicleServer:
         """One line for the log at exit."""
         vehicle = self.vehicle
         assert vehicle is not None
-        stale = self.truth_receiver.stale_uses if self.truth_receiver else 0
+        receiver = self.truth_receiver
+        between, beyond = (receiver.interpolated, receiver.extrapolated) if receiver else (0, 0)
         return (
             f"{vehicle.identity.name}: {vehicle.steps} steps to t={vehicle.sim_time_s:.1f} s; "
             f"link {self.endpoint.summary()}; vehicle rejected: "
             f"{dict(sorted(vehicle.counters.rejected.items())) or 'none'}; "
             f"auto steps {self.stats.auto_steps}, truth waits timed out "
-            f"{self.stats.truth_waits_timed_out}, stale truth {stale}, "
+            f"{self.stats.truth_waits_timed_out}, truth interpolated {between}, extrapolated "
+            f"{beyond}, "
             f"steps resent {self.stats.resent_steps}"
         )
 

@@ -1,10 +1,14 @@
 """Metrics of a run from its tlog alone (plus the scenario's zones), as the paper's Table 3 counts.
 
-- truth: SIM_STATE of each vehicle, grouped by the simulated time the ground station logged;
-- the work UAV's estimate: the VISION_POSITION_ESTIMATE the ground station sent it (each one is
-  followed by the SET_POSITION_TARGET_LOCAL_NED for the same vehicle, which names it);
-- control cycles: the ground station's SYSTEM_TIME clock ticks to the work UAV;
+- truth: SIM_STATE of each vehicle at its own time stamp, on the ground station's clock
+  (:mod:`mission.analysis.truth`), interpolated between samples where needed;
+- the work UAV's estimate: the VISION_POSITION_ESTIMATE the ground station sent it at each
+  control cycle (each one is followed by the SET_POSITION_TARGET_LOCAL_NED for the same
+  vehicle, which names it); the cycles' times are the estimates';
+- the mode: lockstep where the ground station sent clock ticks (SYSTEM_TIME), else real time;
 - completion: the ground station's "Mission complete" STATUSTEXT.
+
+The same holds in both modes: in lockstep every truth sample falls on a cycle's time.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ import numpy as np
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate, truth_time
 from mission.config.settings import Scenario
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
@@ -35,6 +40,7 @@ _WANTED_IDS = frozenset(
         mavlink2.MAVLINK_MSG_ID_SET_POSITION_TARGET_LOCAL_NED,
         mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME,
         mavlink2.MAVLINK_MSG_ID_STATUSTEXT,
+        mavlink2.MAVLINK_MSG_ID_TIMESYNC,
     }
 )
 
@@ -48,17 +54,33 @@ class RunTrace:
     ticks: set[float] = field(default_factory=set)
     completion: float | None = None
     link_events: list[dict[str, Any]] = field(default_factory=list)
+    max_gap_s: float = 1.0  # truth is interpolated between samples at most this far apart
 
     @property
     def supports(self) -> list[int]:
         """System ids of the support vehicles (the work UAV is system 1)."""
         return sorted({s for s, _ in self.truth if s != 1})
 
+    @property
+    def mode(self) -> str:
+        """``lockstep`` (the ground station sent clock ticks) or ``realtime``."""
+        return "lockstep" if self.ticks else "realtime"
+
+    @property
+    def cycle_times(self) -> list[float]:
+        """The control cycles' times (one estimate for the work UAV each)."""
+        return sorted(self.estimates)
+
     def track(self, system: int) -> tuple[np.ndarray, np.ndarray]:
         """(times, positions) of one vehicle's truth."""
         times = sorted(t for s, t in self.truth if s == system)
         points = [self.truth[(system, t)] for t in times]
         return np.array(times), np.array(points).reshape(-1, 3)
+
+    def truth_at(self, system: int, times: list[float]) -> tuple[np.ndarray, np.ndarray]:
+        """One vehicle's truth at these times, and which of them are known."""
+        track_times, positions = self.track(system)
+        return interpolate(track_times, positions, np.array(times), self.max_gap_s)
 
 
 def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
@@ -83,16 +105,24 @@ def _mavutil_messages(tlog: Path) -> Iterator[Any]:
 def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     frame = GeodeticFrame(scenario.world.anchor)
     epoch = scenario.run.epoch_unix_s
-    trace = RunTrace()
+    sample_s = max(scenario.control.t_cont_s, 1.0 / scenario.vehicle.sensor_hz)
+    trace = RunTrace(max_gap_s=2 * sample_s)
     pending_estimate: tuple[float, np.ndarray] | None = None
+    pending_truth: dict[int, np.ndarray] = {}  # a vehicle's SIM_STATE awaiting its step's stamp
+    stamped: list[tuple[int, int, np.ndarray]] = []  # (system, stamp in usec, position)
+    replies: list[TimesyncReply] = []
     for message in messages:
         kind = message.get_type()
         t = round(message._timestamp - epoch, 3)
         source = message.get_srcSystem()
         if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
-            trace.truth[(source, t)] = frame.from_degE7(
-                message.lat_int, message.lon_int, message.alt
-            )
+            pending_truth[source] = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
+        elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
+            if source in pending_truth:
+                stamped.append((source, int(message.time_unix_usec), pending_truth.pop(source)))
+        elif kind == "TIMESYNC" and source != GCS_SYSTEM_ID:
+            received_ns = round(message._timestamp * 1e9 - epoch * 1e9)
+            replies.append(TimesyncReply(source, message.tc1, message.ts1, received_ns))
         elif source != GCS_SYSTEM_ID:
             continue
         elif kind == "VISION_POSITION_ESTIMATE":
@@ -107,6 +137,13 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             trace.completion = t if trace.completion is None else trace.completion
         elif kind == "STATUSTEXT" and _LINK_EVENT.match(message.text):
             trace.link_events.append({"t": t, "event": message.text})
+    offsets = {} if trace.ticks else clock_offsets(replies)
+    epoch_usec = round(epoch * 1e6)
+    for system, stamp, position in stamped:
+        if trace.ticks or system in offsets:
+            trace.truth[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = (
+                position
+            )
     return trace
 
 
@@ -153,26 +190,26 @@ def _wanted_records(data: bytes) -> list[tuple[int, bytes]] | None:
 
 
 def zone_steps(trace: RunTrace, world: World) -> dict[int, list[float]]:
-    """Per support system id, the clock ticks at which its truth was inside a zone."""
+    """Per support system id, the control cycles at whose time its truth was inside a zone."""
     steps: dict[int, list[float]] = defaultdict(list)
-    ticks = sorted(trace.ticks)
+    cycles = trace.cycle_times
     for system in trace.supports:
-        times = [t for t in ticks if (system, t) in trace.truth]
-        if not times:
+        positions, known = trace.truth_at(system, cycles)
+        if not known.any():
             continue
-        inside = world.in_zone(np.array([trace.truth[(system, t)] for t in times]))
+        times = [t for t, k in zip(cycles, known) if k]
+        inside = world.in_zone(positions[known])
         steps[system] = [t for t, hit in zip(times, inside) if hit]
     return steps
 
 
 def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
-    """(times, |xhat - x|) of the work UAV at every cycle with both."""
-    pairs = [
-        (t, float(np.linalg.norm(x - trace.truth[(1, t)])))
-        for t, x in sorted(trace.estimates.items())
-        if (1, t) in trace.truth
-    ]
-    return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+    """(times, |xhat - x|) of the work UAV at every cycle whose truth is known."""
+    times = trace.cycle_times
+    truth, known = trace.truth_at(1, times)
+    estimates = np.array([trace.estimates[t] for t in times]).reshape(-1, 3)
+    errors = np.linalg.norm(estimates[known] - truth[known], axis=1)
+    return np.array(times)[known], errors
 
 
 def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
@@ -214,4 +251,26 @@ def mpc_stats(records: list[dict[str, Any]]) -> dict[str, float | None]:
     return {
         "median": round(float(np.median(times)), 3),
         "p95": round(float(np.percentile(times, 95)), 3),
+    }
+
+
+def measurement_ages(records: list[dict[str, Any]]) -> dict[str, float | None]:
+    """Median, p95 and max of the ages (ms) of the measurements the ground station used, from
+    its records (real time; a lockstep record has no ages: every measurement it used was
+    the step's own, age zero)."""
+    ages = [
+        age
+        for record in records
+        for pair in record.get("age_ms", {}).values()
+        for age in pair
+        if age is not None
+    ]
+    if not ages:
+        ages = [0.0] if records and not any("age_ms" in r for r in records) else []
+    if not ages:
+        return {"median": None, "p95": None, "max": None}
+    return {
+        "median": round(float(np.median(ages)), 1),
+        "p95": round(float(np.percentile(ages, 95)), 1),
+        "max": round(float(np.max(ages)), 1),
     }

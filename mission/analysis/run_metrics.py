@@ -1,5 +1,6 @@
 """Every metric of a run's summary.json that its files determine: the tlog's (Table 3's), the
-support MPCs' solve times and the diagnostics, which also read ``records.jsonl``."""
+mode and the ages of the measurements the ground station used, the support MPCs' solve times
+and the diagnostics, which also read ``records.jsonl``."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from mission.analysis.diagnostics import diagnostics, read_records
-from mission.analysis.metrics import mpc_stats, read_tlog, trace_metrics
+from mission.analysis.metrics import measurement_ages, mpc_stats, read_tlog, trace_metrics
 from mission.config.settings import Scenario
 from mission.world.model import World
 
@@ -17,10 +18,11 @@ def run_metrics(tlog: Path, scenario: Scenario) -> dict[str, Any]:
     station's ``records.jsonl`` lies beside the tlog."""
     trace = read_tlog(tlog, scenario)
     world = World(scenario)
-    metrics = trace_metrics(trace, world)
+    metrics = {"mode": trace.mode, **trace_metrics(trace, world)}
     records_file = tlog.parent / "records.jsonl"
     if records_file.is_file():
         records = read_records(records_file)
+        metrics["measurement_age_ms"] = measurement_ages(records)
         metrics["mpc_solve_ms"] = mpc_stats(records)
         metrics["diagnostics"] = diagnostics(trace, records, world, scenario)
     return metrics

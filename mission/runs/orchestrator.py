@@ -151,6 +151,7 @@ def _summary(options: RunOptions, scenario: Scenario, wall: float) -> dict[str, 
         "scenario_source": scenario.source,
         "method": options.method,
         "seed": options.seed,
+        "speedup": options.speedup,  # None: lockstep
         **run_metrics(options.out_dir / "gcs.tlog", scenario),
     }
     simulated = (summary["control_cycles"] or 0) * scenario.control.t_cont_s

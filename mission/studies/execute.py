@@ -54,6 +54,8 @@ def start(run: StudyRun, run_dir: Path, mpc_helper: bool) -> subprocess.Popen:
         "--mpc-helper" if mpc_helper else "--no-mpc-helper",
         "--exit-with-parent",
     ]
+    if run.speedup is not None:
+        command += ["--realtime", "--speedup", str(run.speedup)]
     with (run_dir / "mission.log").open("w") as log:
         return subprocess.Popen(
             command, stdout=log, stderr=log, stdin=subprocess.DEVNULL, env=child_environment()

@@ -42,6 +42,7 @@ class StudyRun:
     method: str
     seed: int
     key: str  # hex digest of what determines the run's results
+    speedup: float | None = None  # real time at this speed-up; None: lockstep
 
     @property
     def folder(self) -> str:
@@ -73,12 +74,20 @@ def study_runs(spec: StudySpec, names: dict[str, str], code: str) -> list[StudyR
             resolved = resolved_key(scenario, point)
             for seed in spec.seeds:
                 for method in spec.methods:
-                    key = _digest(
-                        {"scenario": resolved, "method": method, "seed": seed, "code": code}
-                    )
+                    identity = {"scenario": resolved, "method": method, "seed": seed, "code": code}
+                    if spec.speedup is not None:  # a lockstep run's key names no clock
+                        identity["realtime"] = spec.speedup
+                    key = _digest(identity)
                     runs.append(
                         StudyRun(
-                            scenario, names[scenario], number, point.as_dict(), method, seed, key
+                            scenario,
+                            names[scenario],
+                            number,
+                            point.as_dict(),
+                            method,
+                            seed,
+                            key,
+                            spec.speedup,
                         )
                     )
     return runs

@@ -13,6 +13,7 @@ points:                       # and/or a list of override sets, each crossed wit
   - {}
   - {fusion.agreement: paper}
 tables: [table3]              # also write the paper's Table 3 (table.md, table.csv, boxplots)
+realtime: 10                  # run in real time at this speed-up (default: lockstep)
 ```
 
 Every (scenario, point) is resolved and validated before anything runs: a bad key or value
@@ -33,7 +34,18 @@ from mission.config.settings import Scenario
 
 METHODS = ("ac", "nac")
 TABLES = ("table3",)
-_KEYS = {"name", "description", "scenarios", "methods", "seeds", "grid", "points", "tables"}
+_KEYS = {
+    "name",
+    "description",
+    "scenarios",
+    "methods",
+    "seeds",
+    "grid",
+    "points",
+    "tables",
+    "realtime",
+}
+MAX_SPEEDUP = 1000.0
 MAX_RUNS = 1_000_000
 
 
@@ -65,6 +77,7 @@ class StudySpec:
     seeds: tuple[int, ...]
     points: tuple[Point, ...]
     tables: tuple[str, ...]
+    speedup: float | None = None  # real time at this speed-up; None: lockstep
 
     @property
     def swept_keys(self) -> list[str]:
@@ -78,6 +91,17 @@ class StudySpec:
     def size(self) -> int:
         """How many runs the study has."""
         return len(self.scenarios) * len(self.points) * len(self.methods) * len(self.seeds)
+
+
+def _speedup(source: str, value: Any) -> float | None:
+    """``realtime``: a speed-up in (0, 1000], or absent (lockstep)."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(source, "realtime", f"must be a speed-up (a number), got {value!r}")
+    if not 0 < value <= MAX_SPEEDUP:
+        raise InputError(source, "realtime", f"must be in (0, {MAX_SPEEDUP:g}], got {value:g}")
+    return float(value)
 
 
 def load_study(path: Path) -> StudySpec:
@@ -117,6 +141,7 @@ def load_study(path: Path) -> StudySpec:
         seeds=_seeds(source, data.get("seeds", 1)),
         points=_points(source, data.get("grid"), data.get("points")),
         tables=tables,
+        speedup=_speedup(source, data.get("realtime")),
     )
     if tables and len(spec.points) > 1:
         raise InputError(source, "tables", "Table 3 is for a study of one point (no grid)")

@@ -33,7 +33,8 @@ def _sim_state(step: int):
 
 
 def _records(epoch: float) -> list[tuple[float, bytes]]:
-    """Two cycles: truth, a GPS fix (never read), the clock, the estimate and command."""
+    """Two cycles: truth, a GPS fix (never read), the vehicle's step marker (the truth's time
+    stamp), the clock, the estimate and command."""
     setpoint = mavlink2.MAVLink_set_position_target_local_ned_message(0, 1, 1, 1, 0, *([0.0] * 11))
     gps = mavlink2.MAVLink_gps_raw_int_message(0, 3, 0, 0, 0, 0, 0, 0, 0, 10)
     records = []
@@ -43,9 +44,11 @@ def _records(epoch: float) -> list[tuple[float, bytes]]:
         )
         clock = mavlink2.MAVLink_system_time_message(0, step * 500)
         t = 0.5 * step
+        marker = mavlink2.MAVLink_system_time_message(round((epoch + t) * 1e6), step * 500)
         records += [
             (t, _packet(2, _sim_state(step))),
             (t, _packet(2, gps)),
+            (t, _packet(2, marker)),
             (t, _packet(255, clock)),
             (t, _packet(255, estimate)),
             (t, _packet(255, setpoint)),

@@ -62,7 +62,7 @@ def test_sim_state_is_logged_but_never_kept_or_used(along, along_world, tmp_path
             ):
                 decoded = codec.decode(codec.encode(message))[0][0]
                 station.links.receive(decoded, ("127.0.0.1", 9))
-        reports = reports_from_messages(station.links.support_messages(), frame)
+        reports = reports_from_messages(station.links.support_samples(), frame)
         assert all(r.fix is not None and r.relative is not None for r in reports)
         assert all("SIM_STATE" not in v.latest for v in station.links.views.values())
         output = run_cycle(state, reports, models)

@@ -26,6 +26,24 @@ def test_keys_differ_by_method_seed_and_override_and_not_by_a_default_restated()
     assert other_code[0].key != runs[0].key
 
 
+def test_a_realtime_run_has_a_key_of_its_own_and_is_started_in_real_time(tmp_path):
+    from dataclasses import replace
+    from unittest import mock
+
+    from mission.studies import execute
+
+    lockstep = study_runs(_spec(), {"along": "along"}, "code")
+    realtime = study_runs(replace(_spec(), speedup=10.0), {"along": "along"}, "code")
+    assert {r.key for r in lockstep}.isdisjoint(r.key for r in realtime)
+    assert realtime[0].speedup == 10.0 and lockstep[0].speedup is None
+    with mock.patch.object(execute.subprocess, "Popen") as popen:
+        execute.start(realtime[0], tmp_path, mpc_helper=True)
+        execute.start(lockstep[0], tmp_path, mpc_helper=True)
+    realtime_command, lockstep_command = (c.args[0] for c in popen.call_args_list)
+    assert realtime_command[-3:] == ["--realtime", "--speedup", "10.0"]
+    assert "--realtime" not in lockstep_command
+
+
 def test_a_key_follows_the_contents_of_the_plan_files_not_their_path(tmp_path):
     plans = embedded_scenarios_dir() / "plans" / "bridge"
     for name in ("a", "b"):

@@ -95,7 +95,8 @@ def test_a_waiting_vehicle_answers_a_new_peer_at_once():
 def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout():
     """In lockstep a support publishes a step once the work UAV's truth of that step is there:
     late truth is waited for; missing truth, for ``vehicle.truth_timeout_wall_s`` (2 s), after
-    which the camera sees the last known position (counted as a stale truth)."""
+    which the camera sees the last known position (counted as an extrapolated truth).
+    Truth samples are keyed by simulated microseconds in lockstep."""
     import numpy as np
 
     from mission.config.scenario import load_scenario
@@ -108,12 +109,12 @@ def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout()
         truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
         client = MavClient(support.address)
         work = np.array([0.0, -4.0, 7.0])
-        truth.publish(work, 500)
+        truth.publish(work, 500_000)
         on_time = _step_marker_after(client, 500)
         assert on_time < 0.5 * timeout
         client.send(mavlink2_tick(1000))
         time.sleep(0.3)
-        truth.publish(work, 1000)  # late, but within the timeout
+        truth.publish(work, 1_000_000)  # late, but within the timeout
         late = _wait_marker(client, 1000, time.monotonic() - 0.3)
         assert 0.3 <= late < 0.3 + 0.5 * timeout
         missing = _step_marker_after(client, 1500)  # no truth at all
@@ -123,7 +124,7 @@ def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout()
         truth.close()
         client.close()
         report = support.stop()
-    assert "truth waits timed out 1, stale truth 1" in report
+    assert "truth waits timed out 1, truth interpolated 0, extrapolated 1" in report
 
 
 def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has():
@@ -140,14 +141,16 @@ def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has():
         assert support.truth_port is not None
         truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
         client = MavClient(support.address)
-        truth.publish(np.array([0.0, -4.0, 7.0]), 1000)  # the next step's truth, not this one's
+        truth.publish(
+            np.array([0.0, -4.0, 7.0]), 1_000_000
+        )  # the next step's truth, not this one's
         time.sleep(0.3)  # it has arrived
         assert _step_marker_after(client, 500) < 0.5 * timeout
         assert _step_marker_after(client, 1000) < 0.5 * timeout  # its own truth: no wait either
         truth.close()
         client.close()
         report = support.stop()
-    assert "truth waits timed out 0, stale truth 1" in report
+    assert "truth waits timed out 0, truth interpolated 0, extrapolated 1" in report
 
 
 def mavlink2_tick(time_ms: int):
@@ -168,3 +171,50 @@ def _wait_marker(client: MavClient, time_ms: int, since: float) -> float:
     marker = client.wait_for("SYSTEM_TIME", 5.0, lambda m: m.time_boot_ms == time_ms)
     assert marker is not None, f"no step marker for {time_ms} ms"
     return time.monotonic() - since
+
+
+def test_in_real_time_a_support_interpolates_the_truth_and_answers_timesync_at_once():
+    """Real time: the work UAV's truth arrives keyed by the host's wall clock at its steps,
+    out of phase with the support's; the support waits for the sample after its own step
+    and interpolates (extrapolates only once the truth stops coming). TIMESYNC is answered
+    with the vehicle's clock at the instant of the reply, not at its last step."""
+    import numpy as np
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+    from vehicle_sim.truth_link import TruthSender
+
+    with vehicle_process("support-1", "--speedup", "10") as support:
+        assert support.truth_port is not None
+        truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
+        client = MavClient(support.address)
+        answers = []
+        start = time.monotonic()
+        sample = 0
+        while time.monotonic() - start < 2.0:
+            wall = time.time()
+            truth.publish(np.array([0.1 * sample, -4.0, 7.0]), round(wall * 1e6))
+            sample += 1
+            if sample % 10 == 5:  # every 0.37 s: a TIMESYNC request (ts1: our wall ns)
+                client.send(mavlink2.MAVLink_timesync_message(0, time.monotonic_ns()))
+            time.sleep(0.037)  # the work UAV's steps, not the support's (0.05 s)
+        answers = [m for m in client.collect(0.3) + client.seen if m.get_type() == "TIMESYNC"]
+        truth.close()
+        client.close()
+        report = support.stop()
+    counts = {
+        name: int(report.split(f"{name} ")[1].split(",")[0])
+        for name in ("truth waits timed out", "truth interpolated", "extrapolated")
+    }
+    assert counts["truth interpolated"] >= 30
+    # extrapolated only after the truth stopped coming (the steps while we stopped)
+    assert counts["extrapolated"] == counts["truth waits timed out"] <= 10
+    by_request = {m.ts1: m.tc1 for m in answers}
+    assert len(by_request) >= 3
+    sent, clock = (
+        np.array(sorted(by_request)),
+        np.array([by_request[k] for k in sorted(by_request)]),
+    )
+    # the vehicle's clock runs 10x the wall clock, continuously (not in 0.5 s steps)
+    rates = np.diff(clock) / np.diff(sent)
+    np.testing.assert_allclose(rates, 10.0, rtol=0.1)
+    assert np.any((clock / 1e9) % 0.5 > 0.05)

@@ -1,0 +1,146 @@
+"""Real time against lockstep: the summary holds in both modes (checked by an independent
+reading of the tlog), the time-stamped measurements keep the estimate as good as lockstep's,
+and lockstep's records are exactly what they were before measurements carried their time."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.processes import ROOT
+
+pytestmark = pytest.mark.slow  # every test here starts processes
+
+SHORT = """
+extends: along
+name: short-run
+task:
+  work_waypoints_m: [[-6.0, -3.0, 7.0], [-3.0, -3.0, 7.0], [0.0, -3.0, 7.0]]
+  waypoints_dir: plan
+run: {timeout_s: 120.0}
+world:
+  zones:
+    - {name: test, min_m: [-14.0, -12.0, 5.0], max_m: [-4.0, -6.0, 11.0], offset_m: [1.0, 0, 0]}
+"""
+# sha256 of the short run's records (seed 0, lockstep) without their wall-clock figures, as
+# the ground station wrote them before measurements carried time stamps. A change that means
+# to alter lockstep results says so by updating it.
+LOCKSTEP_RECORDS_SHA256 = "58b2cc5cc8ccbe12"
+
+
+def _mission(*arguments: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "mission", *arguments],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
+
+
+def _steady_records(out: Path) -> list[dict]:
+    records = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
+    for record in records:
+        del record["cycle_ms"]
+        for solve in record["mpc"].values():
+            del solve["ms"]
+    return records
+
+
+def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
+    scenario = tmp_path / "short-run.yaml"
+    scenario.write_text(SHORT)
+    assert _mission("plan", str(scenario)).returncode == 0
+    result = _mission("run", str(scenario), "--out", str(tmp_path / "run"))
+    assert result.returncode == 0, result.stderr
+    records = _steady_records(tmp_path / "run")
+    assert all("age_ms" not in record for record in records)
+    text = json.dumps(records, sort_keys=True).encode()
+    assert hashlib.sha256(text).hexdigest()[:16] == LOCKSTEP_RECORDS_SHA256
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["mode"] == "lockstep" and summary["speedup"] is None
+    assert summary["measurement_age_ms"] == {"median": 0.0, "p95": 0.0, "max": 0.0}
+
+
+def _independent_pairing(tlog: Path, epoch: float, frame) -> tuple[dict, list, np.ndarray]:
+    """Read the tlog with pymavlink; per vehicle, its truth samples at their SYSTEM_TIME
+    stamps moved onto the station's clock by the TIMESYNC exchange of shortest round trip;
+    the work UAV's estimates at the cycles' times."""
+    os.environ.setdefault("MAVLINK20", "1")
+    from pymavlink import mavutil
+
+    log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega")
+    pending, stamped, exchanges, estimates, last_estimate = {}, [], {}, [], None
+    while (message := log.recv_match()) is not None:
+        kind, source = message.get_type(), message.get_srcSystem()
+        received = message._timestamp - epoch
+        if kind == "SIM_STATE":
+            pending[source] = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
+        elif kind == "SYSTEM_TIME" and source != 255 and source in pending:
+            stamped.append((source, message.time_unix_usec / 1e6 - epoch, pending.pop(source)))
+        elif kind == "TIMESYNC" and source != 255 and message.tc1 > 0:
+            trip = received - message.ts1 / 1e9
+            offset = message.tc1 / 1e9 - (message.ts1 / 1e9 + received) / 2
+            if trip < exchanges.get(source, (np.inf, 0.0))[0]:
+                exchanges[source] = (trip, offset)
+        elif kind == "VISION_POSITION_ESTIMATE" and source == 255:
+            last_estimate = (received, np.array([message.y, message.x, -message.z]))
+        elif kind == "SET_POSITION_TARGET_LOCAL_NED" and source == 255:
+            if last_estimate is not None and message.target_system == 1:
+                estimates.append(last_estimate)
+            last_estimate = None
+    tracks: dict[int, tuple[list, list]] = {}
+    for source, stamp, position in stamped:
+        times, points = tracks.setdefault(source, ([], []))
+        times.append(stamp - exchanges[source][1])
+        points.append(position)
+    return tracks, [t for t, _ in estimates], np.array([x for _, x in estimates])
+
+
+def _at(track: tuple[list, list], times: list[float]) -> np.ndarray:
+    t, points = np.array(track[0]), np.array(track[1])
+    order = np.argsort(t)
+    return np.column_stack([np.interp(times, t[order], points[order][:, i]) for i in range(3)])
+
+
+def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lockstep(
+    tmp_path,
+):
+    from mission.config.scenario import load_scenario
+    from mission.world.frames import GeodeticFrame
+    from mission.world.model import World
+
+    realtime = tmp_path / "realtime"
+    result = _mission("run", "along", "--realtime", "--speedup", "10", "--out", str(realtime))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((realtime / "summary.json").read_text())
+    assert summary["completed"] is True
+    assert summary["mode"] == "realtime" and summary["speedup"] == 10.0
+    ages = summary["measurement_age_ms"]
+    assert 0 < ages["median"] <= ages["p95"] <= ages["max"] <= 1000.0  # at most two cycles
+
+    along = load_scenario("along")
+    tracks, cycles, estimates = _independent_pairing(
+        realtime / "gcs.tlog", along.run.epoch_unix_s, GeodeticFrame(along.world.anchor)
+    )
+    assert len(cycles) == summary["control_cycles"]
+    inside = World(along).in_zone(_at(tracks[2], cycles))  # support-1 crosses the zone
+    assert summary["multipath_steps"]["support-1"] == int(inside.sum()) >= 10
+    # the work UAV's error against its truth interpolated at each cycle's time (every cycle
+    # of a completed run lies within the truth's span)
+    errors = np.linalg.norm(estimates - _at(tracks[1], cycles), axis=1)
+    assert summary["work_error_m"]["mean"] == pytest.approx(float(np.mean(errors)), abs=0.001)
+
+    lockstep = tmp_path / "lockstep"
+    assert _mission("run", "along", "--out", str(lockstep)).returncode == 0
+    reference = json.loads((lockstep / "summary.json").read_text())
+    assert summary["work_error_m"]["mean"] == pytest.approx(
+        reference["work_error_m"]["mean"], rel=0.15
+    )
