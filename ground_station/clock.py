@@ -9,7 +9,9 @@ after a short grace is not waited for, so a dead vehicle does not slow the run.
 
 In real time the cycles keep to a fixed schedule: cycle n runs at n * t_cont of simulated time
 after the flight starts, which is ``n * t_cont / speedup`` wall seconds, however long the
-cycles before it took (a cycle that overran is not made up: the next due one runs).
+cycles before it took (a cycle that overran is not made up: the next due one runs). The
+schedule sits a fifth of a step after the vehicles' common beat (:mod:`mission.procs.
+wall_grid`), so a cycle finds the measurements of the vehicles' latest step.
 """
 
 from __future__ import annotations
@@ -22,6 +24,9 @@ from typing import Any, Protocol
 
 from ground_station.outgoing import clock_tick
 from mission.config.settings import RunSettings
+from mission.procs.wall_grid import next_grid_instant
+
+CYCLE_LAG_STEPS = 0.2  # real time: cycles run this much of a step after the vehicles' beat
 
 
 @dataclass(frozen=True)
@@ -72,9 +77,12 @@ class StationClock:
         self.flight_origin_wall: float | None = None  # real time: when the flight started
 
     def begin_flight(self) -> None:
-        """Real time: the flight starts now (simulated time 0 of the schedule)."""
+        """Real time: the flight starts at the next instant of the schedule (simulated time 0):
+        ``CYCLE_LAG_STEPS`` of a step after the vehicles' common beat, when the measurements
+        of their step have arrived."""
         if self.speedup is not None:
-            self.flight_origin_wall = time.monotonic()
+            step_wall = self.step_s / self.speedup
+            self.flight_origin_wall, _ = next_grid_instant(step_wall, CYCLE_LAG_STEPS * step_wall)
 
     def now_s(self) -> float:
         """Simulated time now: the step's in lockstep; in real time the wall clock's since the

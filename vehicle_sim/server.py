@@ -7,9 +7,10 @@ Stepping lives in :class:`~vehicle_sim.vehicle.Vehicle`; this module only decide
   means "advance to T"; a vehicle started into a running mission takes up the clock from its
   first tick. With no tick for ``lockstep_timeout_wall_s`` the vehicle advances one
   step alone, so a lost packet cannot freeze it; before the first tick it only sends heartbeats.
-- real time: one step every ``t_cont / speedup`` wall seconds from the process's start; the
-  vehicle's simulated clock is its own (as an autopilot's time since boot), and it answers
-  TIMESYNC with it so the ground station can map its time stamps onto its own clock.
+- real time: one step every ``t_cont / speedup`` wall seconds, on the host's common beat
+  (:mod:`mission.procs.wall_grid`: every vehicle samples at the same instants); the vehicle's
+  simulated clock is its own (it counts from its start, as an autopilot's time since boot),
+  and it answers TIMESYNC with it so the ground station can map its stamps onto its clock.
 
 Each step ends with SYSTEM_TIME (the step marker the ground station waits for). A support's
 camera sample of a step needs the work UAV's truth at the same physical time
@@ -33,6 +34,7 @@ from typing import Any
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import Address, UdpEndpoint
+from mission.procs.wall_grid import next_grid_instant
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 
@@ -123,8 +125,10 @@ class VehicleServer:
     def run(self) -> None:
         """Serve until stop() or a signal."""
         assert self.vehicle is not None
-        self._origin_wall = time.monotonic()
-        self._origin_unix = time.time()
+        self._origin_wall, self._origin_unix = time.monotonic(), time.time()
+        if not self.clock.lockstep:  # steps on the host's common beat (sensors on a PPS)
+            step_wall = self.vehicle.step_s / self.clock.speedup
+            self._origin_wall, self._origin_unix = next_grid_instant(step_wall)
         sources: list[Any] = [self.endpoint]
         if self.truth_receiver is not None:
             sources.append(self.truth_receiver)
