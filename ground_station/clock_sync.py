@@ -2,17 +2,17 @@
 
 In real time every vehicle keeps its own simulated clock (its time since start, as an
 autopilot's time since boot) and stamps its measurements with it. The ground station sends
-TIMESYNC requests (``ts1`` = its own time) and each vehicle answers at once with its time
-(``tc1``); NTP's estimate of the vehicle's offset from one exchange is ``tc1 - (ts1 + tr)/2``
-(``tr``: the reply's arrival), off by at most half the round trip. Of the recent exchanges
-the one with the shortest round trip is kept. In lockstep every clock is the ground
-station's: the offset is zero.
+TIMESYNC requests and each vehicle answers at once with its time; of the recent exchanges
+the one with the shortest round trip gives the offset (:mod:`mission.link.timesync`). In
+lockstep every clock is the ground station's: the offset is zero.
 """
 
 from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+
+from mission.link.timesync import exchange_offset
 
 KEEP_EXCHANGES = 16  # recent exchanges the shortest round trip is chosen from
 
@@ -33,11 +33,11 @@ class ClockOffsets:
 
     def observe(self, system_id: int, tc1: int, ts1: int, received_ns: int) -> None:
         """A vehicle's answer (``tc1``, ``ts1``) arrived at ``received_ns``."""
-        round_trip = received_ns - ts1
-        if tc1 <= 0 or round_trip < 0:
+        exchange = exchange_offset(tc1, ts1, received_ns)
+        if exchange is None:
             return  # not an answer to one of ours, or garbage
         kept = self.exchanges.setdefault(system_id, deque(maxlen=KEEP_EXCHANGES))
-        kept.append(Exchange(round_trip, tc1 - (ts1 + received_ns) / 2))
+        kept.append(Exchange(*exchange))
 
     def offset_s(self, system_id: int) -> float | None:
         """The vehicle's clock minus the ground station's, in seconds (None: not known yet)."""

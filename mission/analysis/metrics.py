@@ -258,6 +258,8 @@ def measurement_ages(records: list[dict[str, Any]]) -> dict[str, float | None]:
     """Median, p95 and max of the ages (ms) of the measurements the ground station used, from
     its records (real time; a lockstep record has no ages: every measurement it used was
     the step's own, age zero)."""
+    if records and not any("age_ms" in record for record in records):  # lockstep
+        return {"median": 0.0, "p95": 0.0, "max": 0.0}
     ages = [
         age
         for record in records
@@ -265,8 +267,6 @@ def measurement_ages(records: list[dict[str, Any]]) -> dict[str, float | None]:
         for age in pair
         if age is not None
     ]
-    if not ages:
-        ages = [0.0] if records and not any("age_ms" in r for r in records) else []
     if not ages:
         return {"median": None, "p95": None, "max": None}
     return {

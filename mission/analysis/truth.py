@@ -4,8 +4,8 @@ Each vehicle sends SIM_STATE (its true position) in a step's telemetry, followed
 SYSTEM_TIME marker, whose stamp is the step's time on the vehicle's own clock: the truth's
 time. In lockstep every clock is the ground station's. In real time each vehicle's clock is
 its own; the TIMESYNC exchanges in the tlog give its offset as they gave it to the ground
-station (NTP's estimate of the exchange with the shortest round trip, :mod:`ground_station.
-clock_sync` does the same live). Between samples the truth is interpolated linearly.
+station (the exchange with the shortest round trip, :mod:`mission.link.timesync`). Between
+samples the truth is interpolated linearly.
 """
 
 from __future__ import annotations
@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from mission.link.timesync import exchange_offset
 
 TIME_DECIMALS = 4  # truth times are kept to 0.1 ms (lockstep's fall on whole milliseconds)
 
@@ -33,12 +35,9 @@ def clock_offsets(replies: list[TimesyncReply]) -> dict[int, float]:
     shortest round trip; vehicles with no exchange are not in the result."""
     best: dict[int, tuple[int, float]] = {}
     for reply in replies:
-        round_trip = reply.received_ns - reply.ts1_ns
-        if reply.tc1_ns <= 0 or round_trip < 0:
-            continue
-        offset = reply.tc1_ns - (reply.ts1_ns + reply.received_ns) / 2
-        if reply.system not in best or round_trip < best[reply.system][0]:
-            best[reply.system] = (round_trip, offset)
+        exchange = exchange_offset(reply.tc1_ns, reply.ts1_ns, reply.received_ns)
+        if exchange is not None and exchange[0] < best.get(reply.system, (float("inf"),))[0]:
+            best[reply.system] = exchange
     return {system: offset / 1e9 for system, (_, offset) in best.items()}
 
 

@@ -1,1 +1,1 @@
-"""Process helpers: forks, names, one-line CLI errors, atomic writes. Imports: config."""
+"""Process helpers: forks, names, CLI errors, atomic writes, the real-time beat. Imports: config."""

@@ -94,3 +94,44 @@ def test_a_measurement_of_age_zero_is_used_as_it_is():
     report = SupportReport("support-1", np.array([1.0, 2.0, 3.0]), None, None, 0.0, 0.0)
     (aligned,) = align([report], _state(), 0.5)
     assert aligned is report
+
+
+def test_the_real_time_schedule_keeps_its_beat_and_skips_cycles_it_fell_behind():
+    """Cycle n runs at n t_cont after the flight starts; a cycle that overran is not made up:
+    the next one is the latest due."""
+    import time
+
+    from ground_station.clock import CYCLE_LAG_STEPS, PendingStep, await_step
+
+    class Links:  # receives nothing for as long as the schedule asks, and notes how long
+        def __init__(self) -> None:
+            self.waits: list[float] = []
+
+        def pump(self, seconds, until=None):
+            self.waits.append(seconds)
+            time.sleep(seconds)
+
+    run = types.SimpleNamespace(epoch_unix_s=0.0, timeout_s=100.0)
+    clock = StationClock(run, 0.5, speedup=10.0)  # a step is 50 ms of wall time
+    clock.begin_flight()
+    links = Links()
+    await_step(links, clock, PendingStep(0.5), None)
+    assert clock.time_s == 0.5
+    time.sleep(0.16)  # more than three steps of wall time pass in the cycle (at 0.5 s)
+    await_step(links, clock, PendingStep(0.5), None)
+    assert clock.time_s in (2.0, 2.5)  # the latest due cycle (or the next), not 1.0
+    # the first cycle waits for the beat (at most a step away) and a step; one behind, not at all
+    assert links.waits[0] <= 0.1 + 1e-9 and links.waits[1] == 0.0
+    assert 0 < CYCLE_LAG_STEPS < 1
+
+
+def test_the_beat_is_a_whole_number_of_steps_of_unix_time_plus_the_lag():
+    import time
+
+    from mission.procs.wall_grid import next_grid_instant
+
+    before = time.time()
+    monotonic, unix = next_grid_instant(0.05, lag_s=0.01)
+    assert before - 1e-6 <= unix <= before + 0.05 + 1e-6
+    assert round((unix - 0.01) / 0.05, 6) % 1 == 0
+    assert abs((monotonic - time.monotonic()) - (unix - time.time())) < 0.005

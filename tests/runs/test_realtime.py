@@ -15,20 +15,11 @@ import numpy as np
 import pytest
 
 from tests.processes import ROOT
+from tests.runs.test_run import SHORT
+from tests.runs.test_run import _records as _steady_records
 
 pytestmark = pytest.mark.slow  # every test here starts processes
 
-SHORT = """
-extends: along
-name: short-run
-task:
-  work_waypoints_m: [[-6.0, -3.0, 7.0], [-3.0, -3.0, 7.0], [0.0, -3.0, 7.0]]
-  waypoints_dir: plan
-run: {timeout_s: 120.0}
-world:
-  zones:
-    - {name: test, min_m: [-14.0, -12.0, 5.0], max_m: [-4.0, -6.0, 11.0], offset_m: [1.0, 0, 0]}
-"""
 # sha256 of the short run's records (seed 0, lockstep) without their wall-clock figures, as
 # the ground station wrote them before measurements carried time stamps. A change that means
 # to alter lockstep results says so by updating it.
@@ -43,15 +34,6 @@ def _mission(*arguments: str) -> subprocess.CompletedProcess:
         timeout=600,
         cwd=ROOT,
     )
-
-
-def _steady_records(out: Path) -> list[dict]:
-    records = [json.loads(line) for line in (out / "records.jsonl").read_text().splitlines()]
-    for record in records:
-        del record["cycle_ms"]
-        for solve in record["mpc"].values():
-            del solve["ms"]
-    return records
 
 
 def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
@@ -125,6 +107,7 @@ def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lo
     assert summary["mode"] == "realtime" and summary["speedup"] == 10.0
     ages = summary["measurement_age_ms"]
     assert 0 < ages["median"] <= ages["p95"] <= ages["max"] <= 1000.0  # at most two cycles
+    assert ages["median"] < 250.0  # cycles a fifth of a step (100 ms) after the vehicles' beat
 
     along = load_scenario("along")
     tracks, cycles, estimates = _independent_pairing(
