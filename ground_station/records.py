@@ -34,9 +34,10 @@ class RunRecords:
         time_s: float,
         ages_ms: dict[str, list[float | None]] | None = None,
     ) -> None:
-        """One line: the estimates, S, beta_n, arrival, G's update and each MPC's solve; in
-        real time also the age of each support's [GNSS fix, camera observation] used (ms;
-        None where missing). In lockstep every age is zero and the field is left out."""
+        """One line: the estimates, S, beta_n, arrival, G's update and each MPC's solve (with
+        its predicted path V_n, U positions); in real time also the age of each support's
+        [GNSS fix, camera observation] used (ms; None where missing). In lockstep every age is
+        zero and the field is left out."""
         fusion = output.fusion
         record = {
             "t": round(time_s, 3),
@@ -51,7 +52,12 @@ class RunRecords:
             "arrived": output.arrived,
             "g_updated_voxels": output.updated_voxels,
             "mpc": {
-                n: {"status": p.status, "ms": round(p.solve_ms, 3), "resolved": p.resolved}
+                n: {
+                    "status": p.status,
+                    "ms": round(p.solve_ms, 3),
+                    "resolved": p.resolved,
+                    "path": [_rounded(point) for point in p.path],
+                }
                 for n, p in output.support_plans.items()
             },
             "cycle_ms": round(output.cycle_ms, 3),

@@ -28,6 +28,7 @@ def build_parser() -> OneLineArgumentParser:
     _add_world_parser(commands)
     _add_plan_parser(commands)
     _add_analyze_parser(commands)
+    _add_view_parser(commands)
     _add_bench_parser(commands)
     _add_run_parser(commands)
     _add_batch_parser(commands)
@@ -87,6 +88,19 @@ def _add_analyze_parser(commands) -> None:
     analyze.add_argument(
         "--plots", action="store_true", help="draw the paper's figures into DIR/plots/"
     )
+
+
+def _add_view_parser(commands) -> None:
+    """``mission view``'s arguments."""
+    view = commands.add_parser("view", help="replay a run in 3-D (Rerun): native, web or a file")
+    view.add_argument("run", type=Path, metavar="RUN_DIR", help="a run's directory")
+    view.add_argument(
+        "--web", action="store_true", help="serve the web viewer on 127.0.0.1 and print its URL"
+    )
+    view.add_argument(
+        "--save", type=Path, metavar="FILE.rrd", help="write the recording (open: rerun FILE.rrd)"
+    )
+    view.add_argument("--scenario", help="scenario of the run (default: from summary.json)")
 
 
 def _add_bench_parser(commands) -> None:
@@ -228,6 +242,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "run": subcommands.run,
         "bench": subcommands.bench,
         "analyze": subcommands.analyze,
+        "view": subcommands.view,
         "plan": subcommands.plan,
         "batch": study_commands.batch,
         "study": study_commands.study,

@@ -211,7 +211,6 @@ def plan_directory(out: Path | None, scenario) -> Path:
 def analyze(args: argparse.Namespace) -> int:
     """``mission analyze``."""
     from mission.analysis.run_metrics import run_metrics
-    from mission.config.scenario import load_scenario
 
     tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
     if not tlog.is_file():
@@ -220,19 +219,7 @@ def analyze(args: argparse.Namespace) -> int:
         raise InputError(str(tlog), "", "is empty")
     summary_path = tlog.parent / "summary.json"
     previous = _previous_summary(summary_path)
-    beside = tlog.parent / "scenario.yaml"  # a study's run carries the scenario it ran
-    source = previous.get("scenario_source")
-    if source is not None and not Path(source).is_file():
-        source = None  # resolved on another machine (a Ray node's temporary folder)
-    scenario_name = (
-        args.scenario
-        or (str(beside) if beside.is_file() else None)
-        or source
-        or previous.get("scenario")
-    )
-    if scenario_name is None:
-        raise InputError(str(args.run), "--scenario", "unknown scenario: give --scenario")
-    scenario = load_scenario(scenario_name)
+    scenario = _run_scenario(args.run, tlog.parent, previous, args.scenario)
     metrics = run_metrics(tlog, scenario)
     if not metrics["control_cycles"]:
         raise InputError(str(tlog), "", "holds no control cycle of a ground station")
@@ -253,6 +240,48 @@ def analyze(args: argparse.Namespace) -> int:
         for path in plot_run(trace, World(scenario), tlog.parent / "g", plots, label):
             print(f"wrote {path}")
     return 0
+
+
+def _run_scenario(given: Path, run_dir: Path, previous: dict, explicit: str | None):
+    """The scenario a run ran: ``--scenario``, else the scenario.yaml a study's run carries,
+    else the file or name its summary.json names."""
+    from mission.config.scenario import load_scenario
+
+    beside = run_dir / "scenario.yaml"
+    source = previous.get("scenario_source")
+    if source is not None and not Path(source).is_file():
+        source = None  # resolved on another machine (a Ray node's temporary folder)
+    scenario_name = (
+        explicit or (str(beside) if beside.is_file() else None) or source or previous.get("scenario")
+    )
+    if scenario_name is None:
+        raise InputError(str(given), "--scenario", "unknown scenario: give --scenario")
+    return load_scenario(scenario_name)
+
+
+def view(args: argparse.Namespace) -> int:
+    """``mission view``."""
+    run_dir = args.run
+    for name in ("gcs.tlog", "records.jsonl"):
+        if not (run_dir / name).is_file():
+            raise InputError(str(run_dir), "", f"no {name} here (give a run's directory)")
+    if (run_dir / "gcs.tlog").stat().st_size == 0:
+        raise InputError(str(run_dir / "gcs.tlog"), "", "is empty")
+    if args.save is not None:
+        check_output_file(args.save, "--save", (".rrd",))
+    previous = _previous_summary(run_dir / "summary.json")
+    scenario = _run_scenario(run_dir, run_dir, previous, args.scenario)
+    from mission.viewer.process import ViewerFailed
+    from mission.viewer.replay import replay_run, viewer_kind
+
+    viewer = viewer_kind(args.web) if args.web or args.save is None else None
+    if viewer == "web" and not args.web:
+        print("no display for a native viewer: serving the web viewer", file=sys.stderr)
+    try:
+        return replay_run(run_dir, scenario, viewer, args.save)
+    except ViewerFailed as error:
+        print(f"view failed: {error}", file=sys.stderr)
+        return 1
 
 
 def _previous_summary(path: Path) -> dict:

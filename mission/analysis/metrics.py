@@ -172,21 +172,34 @@ def _tlog_messages(tlog: Path) -> Iterator[Any]:
 
 def _wanted_records(data: bytes) -> list[tuple[int, bytes]] | None:
     """(microseconds, packet) of the wanted kinds, or None if ``data`` is not plain MAVLink 2."""
-    records, offset, end = [], 0, len(data)
+    records, end, clean = scan_records(data, _WANTED_IDS)
+    return records if clean and end == len(data) else None
+
+
+def scan_records(
+    data: bytes, wanted: frozenset[int], start: int = 0
+) -> tuple[list[tuple[int, bytes]], int, bool]:
+    """The (microseconds, packet) records of the ``wanted`` message ids in ``data`` from
+    ``start``; the offset just past the last whole record; and whether everything up to it
+    was well-formed MAVLink 2 (a cut record at the end is not an error: a tlog still being
+    written ends in one)."""
+    records, offset, end = [], start, len(data)
     while offset < end:
-        start = offset + 8
-        if start + 10 > end or data[start] != mavlink2.PROTOCOL_MARKER_V2:
-            return None
-        length = data[start + 1]
-        size = 10 + length + 2 + (13 if data[start + 2] & mavlink2.MAVLINK_IFLAG_SIGNED else 0)
-        if start + size > end:
-            return None
-        msgid = int.from_bytes(data[start + 7 : start + 10], "little")
-        if msgid in _WANTED_IDS:
-            usec = int.from_bytes(data[offset:start], "big")
-            records.append((usec, data[start : start + size]))
-        offset = start + size
-    return records
+        begin = offset + 8
+        if begin + 10 > end:
+            break
+        if data[begin] != mavlink2.PROTOCOL_MARKER_V2:
+            return records, offset, False
+        length = data[begin + 1]
+        size = 10 + length + 2 + (13 if data[begin + 2] & mavlink2.MAVLINK_IFLAG_SIGNED else 0)
+        if begin + size > end:
+            break
+        msgid = int.from_bytes(data[begin + 7 : begin + 10], "little")
+        if msgid in wanted:
+            usec = int.from_bytes(data[offset:begin], "big")
+            records.append((usec, data[begin : begin + size]))
+        offset = begin + size
+    return records, offset, True
 
 
 def zone_steps(trace: RunTrace, world: World) -> dict[int, list[float]]:

@@ -1,0 +1,81 @@
+"""The rows of the ground station's control cycles (``records.jsonl``): the estimates, which
+supports were fused (S), beta_n, each MPC's solve time and predicted path, the current
+waypoint; and, once the truth has reached a cycle's time, the work UAV's error and the steps
+each support has spent in a zone (counted as the metrics count them)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from mission.viewer import frame as f
+
+if TYPE_CHECKING:
+    from mission.viewer.assemble import RunAssembler
+
+
+class CycleRows:
+    """Per-cycle rows, from records fed in order."""
+
+    def __init__(self, run: RunAssembler, waypoints: dict[str, np.ndarray]) -> None:
+        self.run = run
+        self.waypoints = waypoints
+        self.times: list[float] = []  # every cycle's time so far
+        self.zone_steps = {n: 0 for n in run.names.values() if n != "work"}
+        self._waypoint: int | None = None
+        self._pending: list[tuple[float, np.ndarray]] = []  # (t, xhat) awaiting the truth
+
+    def add(self, records: list[dict[str, Any]], out: f.Frame) -> None:
+        for record in records:
+            t = float(record["t"])
+            self.times.append(t)
+            xhat = np.array(record["xhat"], dtype=float)
+            out.points[f.estimate_path("work")].add(t, xhat, f.ESTIMATE_COLOUR)
+            fused = set(record.get("consistent", []))
+            for name, yhat in record.get("yhat", {}).items():
+                colour = f.colour_of(name) if name in fused else f.EXCLUDED_COLOUR
+                out.points[f.estimate_path(name)].add(t, np.array(yhat, dtype=float), colour)
+                out.scalars[f.scalar_path("fused", name)].add(t, float(name in fused))
+            for name, beta in record.get("beta", {}).items():
+                if beta is not None:  # None: the support gave no measurement this cycle
+                    out.scalars[f.scalar_path("beta", name)].add(t, float(beta))
+            for name, solve in record.get("mpc", {}).items():
+                out.scalars[f.scalar_path("solve_ms", name)].add(t, float(solve["ms"]))
+                if solve.get("path"):
+                    path = np.array(solve["path"], dtype=float).reshape(-1, 3)
+                    out.strips[f.mpc_path(name)].add(t, path, f.colour_of(name))
+            self._current_waypoint(int(record["k"]), t, out)
+            self._pending.append((t, xhat))
+
+    def _current_waypoint(self, k: int, t: float, out: f.Frame) -> None:
+        """Each vehicle's current waypoint w_{n,k}, logged when k changes."""
+        if k == self._waypoint:
+            return
+        self._waypoint = k
+        for name, points in self.waypoints.items():
+            if len(points):
+                point = points[min(max(k, 0), len(points) - 1)]
+                out.points[f.current_waypoint_path(name)].add(t, point, f.colour_of(name))
+
+    def resolve(self, out: f.Frame, final: bool) -> None:
+        """The error and steps in a zone of the cycles whose truth has come."""
+        names = list(self.run.tracks)
+        ready = [(t, x) for t, x in self._pending if self.run.ready(names, t, final)]
+        self._pending = self._pending[len(ready) :]
+        if not ready:
+            return
+        times = [t for t, _ in ready]
+        truth, known = self.run.truth_at("work", times)
+        for (t, xhat), position, ok in zip(ready, truth, known):
+            if ok:
+                error = float(np.linalg.norm(xhat - position))
+                out.scalars[f.scalar_path("work_error")].add(t, error)
+        for name in self.zone_steps:
+            positions, known = self.run.truth_at(name, times)
+            inside = np.zeros(len(times), dtype=bool)
+            if known.any():
+                inside[known] = self.run.world.in_zone(positions[known])
+            for t, hit in zip(times, inside):
+                self.zone_steps[name] += int(hit)
+                out.scalars[f.scalar_path("zone_steps", name)].add(t, self.zone_steps[name])

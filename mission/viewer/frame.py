@@ -1,0 +1,122 @@
+"""What the view logs, as plain rows per entity (no Rerun here): a :class:`Frame` is what is new
+since the last one; :mod:`mission.viewer.send` turns it into Rerun columns.
+
+Entity paths, colours and sizes are named here once, so the replay, the live view, the layout
+and the tests agree on them.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+TIMELINE = "sim_time"  # simulated seconds since the run's epoch
+
+Rgb = tuple[int, int, int]
+WORK_COLOUR: Rgb = (230, 57, 70)
+SUPPORT_COLOURS: tuple[Rgb, ...] = (
+    (30, 136, 229),
+    (67, 160, 71),
+    (255, 179, 0),
+    (142, 36, 170),
+    (0, 172, 193),
+)
+BRIDGE_COLOUR: Rgb = (181, 156, 120)
+ZONE_COLOUR: Rgb = (255, 64, 129)
+WORKSPACE_COLOUR: Rgb = (120, 120, 120)
+ESTIMATE_COLOUR: Rgb = (255, 138, 128)  # xhat
+EXCLUDED_COLOUR: Rgb = (140, 140, 140)  # yhat_n of a support left out of S
+IN_ZONE_FIX_COLOUR: Rgb = ZONE_COLOUR  # a GNSS fix taken inside a multipath zone
+UNKNOWN_COLOUR: Rgb = (200, 200, 200)  # a fix whose truth is not in the log
+VISIBLE_COLOUR: Rgb = (224, 224, 224)
+BLOCKED_COLOUR: Rgb = (255, 112, 67)
+G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)
+G_CHANGED_M = 0.01  # a voxel is shown once G differs from its initial value by this much
+
+UAV_RADIUS_M = 0.6
+ESTIMATE_RADIUS_M = 0.3
+FIX_RADIUS_M = 0.12
+
+
+def colour_of(name: str) -> Rgb:
+    """A vehicle's colour: the work UAV red, the supports blue, green, amber, ..."""
+    if name == "work":
+        return WORK_COLOUR
+    number = int(name.rsplit("-", 1)[-1])
+    return SUPPORT_COLOURS[(number - 1) % len(SUPPORT_COLOURS)]
+
+
+def uav_path(name: str) -> str:
+    """A vehicle's true position (SIM_STATE)."""
+    return f"uav/{name}"
+
+
+def estimate_path(name: str) -> str:
+    """The ground station's estimate: xhat for the work UAV, yhat_n for a support."""
+    return f"estimate/{name}"
+
+
+def fix_path(name: str) -> str:
+    return f"gnss/{name}"
+
+
+def sight_path(name: str) -> str:
+    return f"sight/{name}"
+
+
+def mpc_path(name: str) -> str:
+    return f"mpc/{name}"
+
+
+def current_waypoint_path(name: str) -> str:
+    return f"plan/{name}/current"
+
+
+def scalar_path(kind: str, name: str | None = None) -> str:
+    """``plots/work_error``, ``plots/beta/support-1``, ``plots/solve_ms/...``,
+    ``plots/zone_steps/...``, ``plots/fused/...``."""
+    return f"plots/{kind}" if name is None else f"plots/{kind}/{name}"
+
+
+G_PATH = "map/G"
+
+
+@dataclass
+class Rows:
+    """One entity's rows: a time and a value each (and a colour, for points and strips)."""
+
+    times: list[float] = field(default_factory=list)
+    values: list[Any] = field(default_factory=list)
+    colours: list[Rgb] = field(default_factory=list)
+
+    def add(self, time_s: float, value: Any, colour: Rgb | None = None) -> None:
+        self.times.append(time_s)
+        self.values.append(value)
+        if colour is not None:
+            self.colours.append(colour)
+
+
+@dataclass(frozen=True)
+class VoxelRow:
+    """G where it differs from its initial value, at a snapshot's time."""
+
+    time_s: float
+    indices: np.ndarray  # (V, 3) voxel indices
+    values: np.ndarray  # (V,) G there, metres
+
+
+@dataclass
+class Frame:
+    """New rows since the last frame: points (one position each), strips (one polyline each),
+    scalars, and G's snapshots."""
+
+    points: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
+    strips: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
+    scalars: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
+    voxels: list[VoxelRow] = field(default_factory=list)
+
+    def __bool__(self) -> bool:
+        return bool(self.points or self.strips or self.scalars or self.voxels)

@@ -1,0 +1,50 @@
+"""What does not move: the structure's mesh, the multipath zones (analysis may show them; the
+ground station never sees them), the workspace and each vehicle's planned waypoints."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.config.errors import InputError
+from mission.config.settings import Scenario
+from mission.link.plan_files import read_vehicle_waypoints, vehicle_names
+from mission.world.model import World
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The static part of the view, ENU metres."""
+
+    vertices: np.ndarray  # (V, 3) of the structure's mesh
+    triangles: np.ndarray  # (T, 3)
+    zones: list[tuple[str, np.ndarray, np.ndarray]]  # (name, min corner, max corner)
+    workspace: tuple[np.ndarray, np.ndarray]
+    waypoints: dict[str, np.ndarray]  # per vehicle, (I, 3); empty where the plan is missing
+    voxel_origin: np.ndarray
+    voxel_m: float
+
+
+def build_scene(scenario: Scenario, world: World) -> Scene:
+    """The scene of a scenario's world; a vehicle whose waypoint file is gone gets none (said
+    on stderr), since a run's view does not need them to show what happened."""
+    waypoints = {}
+    for name in vehicle_names(scenario.task.supports):
+        try:
+            waypoints[name] = read_vehicle_waypoints(scenario, name)
+        except InputError as error:
+            print(f"view: no planned waypoints shown for {name}: {error}", file=sys.stderr)
+            waypoints[name] = np.zeros((0, 3))
+    space = scenario.world.workspace
+    grid = world.map_grid()
+    return Scene(
+        vertices=world.structure.vertices,
+        triangles=world.structure.faces,
+        zones=[(z.name, np.array(z.min_m), np.array(z.max_m)) for z in scenario.world.zones],
+        workspace=(np.array(space.min_m), np.array(space.max_m)),
+        waypoints=waypoints,
+        voxel_origin=np.array(grid.origin_m, dtype=float),
+        voxel_m=float(grid.voxel_m),
+    )
