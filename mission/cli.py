@@ -163,6 +163,13 @@ def _add_run_parser(commands) -> None:
         "started as python -m ground_station / vehicle_sim (slower; ps shows its command "
         "line). Same results either way",
     )
+    run.add_argument(
+        "--view",
+        nargs="?",
+        const="auto",
+        choices=["auto", "web", "native"],
+        help="stream the run to a Rerun viewer (auto: native with a display, else web)",
+    )
     run.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
 
 

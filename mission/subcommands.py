@@ -85,13 +85,39 @@ def run(args: argparse.Namespace) -> int:
         args.process_start,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
+    live = None
     try:
-        summary = run_mission(options, scenario)
+        live = _live_view(args.view, out, scenario) if args.view else None
+        summary = run_mission(options, scenario, live)
+        print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
+        if live is not None and live.viewer is not None:
+            from mission.viewer.replay import wait_for_viewer
+
+            wait_for_viewer(live.viewer)
     except RunFailed as error:
         print(f"run failed: {error}; logs kept in {out}", file=sys.stderr)
         return 1
-    print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
+    finally:
+        if live is not None:
+            live.close()
     return 0
+
+
+def _live_view(choice: str, out: Path, scenario):
+    """The live view of ``mission run --view``: its viewer started (and its URL said)."""
+    from mission.runs.orchestrator import RunFailed
+    from mission.viewer.live import LiveView
+    from mission.viewer.process import ViewerFailed, start_viewer
+    from mission.viewer.replay import viewer_kind
+
+    kind = "native" if choice == "native" else viewer_kind(choice == "web")
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        viewer = start_viewer(kind, out / "viewer.log")
+    except ViewerFailed as error:
+        raise RunFailed(f"the viewer: {error}") from None
+    print(f"streaming to the viewer at {viewer.web_url or 'its native window'}", flush=True)
+    return LiveView(out, scenario, viewer)
 
 
 def realtime_speedup(args: argparse.Namespace) -> float | None:
@@ -252,7 +278,10 @@ def _run_scenario(given: Path, run_dir: Path, previous: dict, explicit: str | No
     if source is not None and not Path(source).is_file():
         source = None  # resolved on another machine (a Ray node's temporary folder)
     scenario_name = (
-        explicit or (str(beside) if beside.is_file() else None) or source or previous.get("scenario")
+        explicit
+        or (str(beside) if beside.is_file() else None)
+        or source
+        or previous.get("scenario")
     )
     if scenario_name is None:
         raise InputError(str(given), "--scenario", "unknown scenario: give --scenario")

@@ -26,6 +26,7 @@ SHORT_NAMES = {  # the names the docstrings use for the project's packages
     "planning": "mission.planning",
     "runs": "mission.runs",
     "studies": "mission.studies",
+    "viewer": "mission.viewer",
     "ground_station": "ground_station",
     "vehicle_sim": "vehicle_sim",
 }

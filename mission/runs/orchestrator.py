@@ -21,7 +21,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
 
 from mission.analysis.run_metrics import run_metrics
 from mission.config.settings import Scenario
@@ -62,6 +62,14 @@ class RunOptions:
             raise ValueError(f"process_start must be fork or exec, not {self.process_start!r}")
 
 
+class RunWatcher(Protocol):
+    """Something that follows the run's folder while it runs (the live view)."""
+
+    def poll(self) -> None: ...
+
+    def finish(self) -> None: ...
+
+
 @dataclass
 class Child:
     """A started child process and its log."""
@@ -71,8 +79,11 @@ class Child:
     log: Path
 
 
-def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
-    """Run a mission to completion or timeout; return its summary (also in summary.json)."""
+def run_mission(
+    options: RunOptions, scenario: Scenario, watcher: RunWatcher | None = None
+) -> dict[str, Any]:
+    """Run a mission to completion or timeout; return its summary (also in summary.json).
+    ``watcher`` is polled while the ground station runs, and finished once it has."""
     options.out_dir.mkdir(parents=True, exist_ok=True)
     children: list[Child] = []
     start = time.monotonic()
@@ -84,7 +95,7 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
     }
     try:
         gcs = _start_processes(options, scenario, children)
-        _supervise(gcs, children, required={"work"})
+        _supervise(gcs, children, {"work"}, watcher)
         if gcs.process.returncode != 0:
             raise RunFailed(
                 f"ground_station exited with status {gcs.process.returncode} (see {gcs.log})"
@@ -93,6 +104,8 @@ def run_mission(options: RunOptions, scenario: Scenario) -> dict[str, Any]:
         _stop_all(children)
         for number, handler in previous.items():
             signal.signal(number, handler)
+    if watcher is not None:
+        watcher.finish()
     summary = _summary(options, scenario, time.monotonic() - start)
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
@@ -226,10 +239,12 @@ def _launch(
     return Child(name, process, log)
 
 
-def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
+def _supervise(
+    gcs: Child, children: list[Child], required: set[str], watcher: RunWatcher | None
+) -> None:
     """Wait for the ground station; a dead required vehicle, or one that never started,
     ends the run with an error. What the ground station says of a first run's compilation is
-    shown as it comes."""
+    shown as it comes; the watcher is polled."""
     relay = LogRelay(gcs.log, COMPILE_NEWS)
     while True:
         try:
@@ -238,6 +253,8 @@ def _supervise(gcs: Child, children: list[Child], required: set[str]) -> None:
             return
         except subprocess.TimeoutExpired:
             relay.poll()
+            if watcher is not None:
+                watcher.poll()
         for child in children:
             if child is gcs or child.process.poll() is None:
                 continue

@@ -5,20 +5,30 @@ each support has spent in a zone (counted as the metrics count them)."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from mission.viewer import frame as f
+from mission.world.model import World
 
-if TYPE_CHECKING:
-    from mission.viewer.assemble import RunAssembler
+
+class TruthSource(Protocol):
+    """What the cycles need of the truth read so far (:class:`~.assemble.RunAssembler`)."""
+
+    names: dict[int, str]
+    tracks: dict[str, Any]
+    world: World
+
+    def ready(self, names: list[str], t: float, final: bool) -> bool: ...
+
+    def truth_at(self, name: str, times: list[float]) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 class CycleRows:
     """Per-cycle rows, from records fed in order."""
 
-    def __init__(self, run: RunAssembler, waypoints: dict[str, np.ndarray]) -> None:
+    def __init__(self, run: TruthSource, waypoints: dict[str, np.ndarray]) -> None:
         self.run = run
         self.waypoints = waypoints
         self.times: list[float] = []  # every cycle's time so far

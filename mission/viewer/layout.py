@@ -17,8 +17,8 @@ TRACKED += ["+ /gnss/**"]
 
 def blueprint(scene: Scene) -> rrb.Blueprint:
     """Left: the 3-D view (what is at the time cursor: positions, estimates, fixes, sight
-    lines, MPC paths, G) over the top view (the tracks up to the cursor, without the deck). Right: the work
-    UAV's error, beta_n, steps in a zone, S and the MPC solve times."""
+    lines, MPC paths, G) over the top view (the tracks up to the cursor, without the deck).
+    Right: the work UAV's error, beta_n, steps in a zone, S and the MPC solve times."""
     low, high = scene.workspace
     centre = (low + high) / 2
     span = float(np.max(high - low))
@@ -49,14 +49,18 @@ def blueprint(scene: Scene) -> rrb.Blueprint:
     )
     hidden = rrb.PlotLegend(visible=False)  # the supports' colours say who is who
     plots = rrb.Vertical(
-        rrb.TimeSeriesView(name="work UAV error (m)", origin="/plots/work_error", plot_legend=hidden),
+        rrb.TimeSeriesView(
+            name="work UAV error (m)", origin="/plots/work_error", plot_legend=hidden
+        ),
         rrb.TimeSeriesView(name="steps in a zone", origin="/plots/zone_steps"),
         rrb.TimeSeriesView(name="beta_n", origin="/plots/beta", plot_legend=hidden),
         rrb.TimeSeriesView(name="fused (in S)", origin="/plots/fused", plot_legend=hidden),
         rrb.TimeSeriesView(name="MPC solve (ms)", origin="/plots/solve_ms", plot_legend=hidden),
     )
     return rrb.Blueprint(
-        rrb.Horizontal(rrb.Vertical(formation, top, row_shares=[3, 2]), plots, column_shares=[3, 2]),
+        rrb.Horizontal(
+            rrb.Vertical(formation, top, row_shares=[3, 2]), plots, column_shares=[3, 2]
+        ),
         rrb.TimePanel(timeline=f.TIMELINE, play_state="following", state="collapsed"),
         collapse_panels=True,
     )

@@ -110,7 +110,7 @@ def start_viewer(kind: Literal["web", "native"], log: Path | None = None) -> Vie
             stdout=handle,
             stderr=subprocess.STDOUT,
             env=viewer_environment(),
-            preexec_fn=die_with_parent,  # noqa: PLW1509 (no threads yet: see live.py)
+            preexec_fn=die_with_parent,  # (before any thread of Rerun's: see live.py)
         )
     viewer = ViewerProcess(process, "", None, log, temporary)
     try:

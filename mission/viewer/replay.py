@@ -50,13 +50,18 @@ def wait_for_viewer(process: ViewerProcess) -> None:
     """Say where the viewer is, then wait until its window is closed, Ctrl-C or SIGTERM."""
     where = process.web_url or "the native viewer's window"
     print(f"viewer at {where} (Ctrl-C to stop)", flush=True)
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    # Ctrl-C and SIGTERM end the wait, even where SIGINT was ignored (a background job)
+    previous = {
+        signal.SIGTERM: signal.signal(signal.SIGTERM, _interrupt),
+        signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
+    }
     try:
         process.process.wait()
     except KeyboardInterrupt:
         print("viewer stopped", file=sys.stderr)
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 def _interrupt(*_: object) -> None:

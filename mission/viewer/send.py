@@ -37,13 +37,26 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
         labels = [name for name, _, _ in scene.zones]
         rec.log(
             "world/zones",
-            rr.Boxes3D(mins=mins, sizes=sizes, labels=labels, colors=f.ZONE_COLOUR, radii=0.06),
+            rr.Boxes3D(
+                mins=mins,
+                sizes=sizes,
+                labels=labels,
+                colors=f.ZONE_COLOUR,
+                radii=0.06,
+                fill_mode=rr.components.FillMode.MajorWireframe,
+            ),
             static=True,
         )
     low, high = scene.workspace
     rec.log(
         "world/workspace",
-        rr.Boxes3D(mins=[low], sizes=[high - low], colors=f.WORKSPACE_COLOUR, radii=0.03),
+        rr.Boxes3D(
+            mins=[low],
+            sizes=[high - low],
+            colors=f.WORKSPACE_COLOUR,
+            radii=0.03,
+            fill_mode=rr.components.FillMode.MajorWireframe,
+        ),
         static=True,
     )
     for name, points in scene.waypoints.items():

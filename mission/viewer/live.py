@@ -1,0 +1,70 @@
+"""``mission run --view``: the run streamed to a viewer while it flies.
+
+The orchestrator calls :meth:`LiveView.poll` from its supervision loop; each call reads what
+the ground station has added to its files since the last (the same reading as the replay, so
+the live view and ``mission view`` show the same rows) and streams it. Rerun is imported, and
+its recording (with its threads) made, only at the first poll: by then every vehicle has been
+forked, which a process with threads may not do.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from mission.config.settings import Scenario
+from mission.viewer.feed import RunFeed
+from mission.viewer.process import ViewerProcess, stop_viewer
+
+POLL_EVERY_S = 0.25  # wall seconds between two reads of the run's files
+
+
+class LiveView:
+    """Streams a running mission's folder to a viewer and/or a recording file."""
+
+    def __init__(
+        self,
+        out_dir: Path,
+        scenario: Scenario,
+        viewer: ViewerProcess | None,
+        save: Path | None = None,
+    ) -> None:
+        self.out_dir = out_dir
+        self.scenario = scenario
+        self.viewer = viewer
+        self.save = save
+        self._feed: RunFeed | None = None
+        self._rec: Any = None
+        self._last = float("-inf")
+
+    def poll(self, final: bool = False) -> None:
+        """Stream what is new (at most every POLL_EVERY_S, unless ``final``)."""
+        now = time.monotonic()
+        if not final and now - self._last < POLL_EVERY_S:
+            return
+        self._last = now
+        if self._rec is None:
+            from mission.viewer.recording import open_recording
+
+            self._feed = RunFeed(self.out_dir, self.scenario)
+            url = self.viewer.grpc_url if self.viewer else None
+            self._rec = open_recording(self.out_dir.name, self._feed.scene, url, self.save)
+        from mission.viewer.send import send_frame
+
+        assert self._feed is not None
+        frame = self._feed.read(final)
+        if frame:
+            send_frame(self._rec, frame, self._feed.scene)
+
+    def finish(self) -> None:
+        """The run is over: stream the rest and complete the recording."""
+        self.poll(final=True)
+        from mission.viewer.recording import close_recording
+
+        close_recording(self._rec)
+
+    def close(self) -> None:
+        """Stop the viewer (after :func:`~mission.viewer.replay.wait_for_viewer`, if wanted)."""
+        if self.viewer is not None:
+            stop_viewer(self.viewer)
