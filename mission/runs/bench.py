@@ -19,6 +19,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.runs.bench_result import BenchResult
 from mission.runs.bench_study import bench_studies
+from mission.runs.bench_view import bench_view
 
 
 def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
@@ -318,6 +319,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "gcs": bench_ground_station,
     "run": bench_runs,
     "study": bench_studies,
+    "view": bench_view,
 }
 
 

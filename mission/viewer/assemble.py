@@ -141,30 +141,42 @@ class RunAssembler:
         return final or all(self.tracks[n].last >= t for n in names)
 
     def _resolve_fixes(self, out: f.Frame, final: bool) -> None:
-        waiting = []
-        for name, t, position in self._fixes:
-            if not self.ready([name], t, final):
-                waiting.append((name, t, position))
-                continue
-            truth, known = self.truth_at(name, [t])
-            if not known[0]:
-                colour = f.UNKNOWN_COLOUR
-            elif self.world.in_zone(truth)[0]:
-                colour = f.IN_ZONE_FIX_COLOUR
-            else:
-                colour = f.colour_of(name)
-            out.points[f.fix_path(name)].add(t, position, colour)
-        self._fixes = waiting
+        """Each fix, coloured by whether its support was in a zone (truth at the fix's time)."""
+        ready, self._fixes = self._split(self._fixes, lambda item: [item[0]], final)
+        for name, items in _by_name(ready).items():
+            truth, known = self.truth_at(name, [t for _, t, _ in items])
+            inside = np.zeros(len(items), dtype=bool)
+            if known.any():
+                inside[known] = self.world.in_zone(truth[known])
+            for (_, t, position), ok, hit in zip(items, known, inside):
+                colour = f.colour_of(name) if ok else f.UNKNOWN_COLOUR
+                out.points[f.fix_path(name)].add(
+                    t, position, f.IN_ZONE_FIX_COLOUR if hit else colour
+                )
 
     def _resolve_sights(self, out: f.Frame, final: bool) -> None:
-        waiting = []
-        for name, t, seen in self._sights:
-            if not self.ready([name, "work"], t, final):
-                waiting.append((name, t, seen))
-                continue
-            start, known_start = self.truth_at(name, [t])
-            end, known_end = self.truth_at("work", [t])
-            if known_start[0] and known_end[0]:
-                colour = f.VISIBLE_COLOUR if seen else f.BLOCKED_COLOUR
-                out.strips[f.sight_path(name)].add(t, np.vstack([start[0], end[0]]), colour)
-        self._sights = waiting
+        """Each sighting, as the line between the true support and the true work UAV."""
+        ready, self._sights = self._split(self._sights, lambda item: [item[0], "work"], final)
+        for name, items in _by_name(ready).items():
+            times = [t for _, t, _ in items]
+            starts, known_starts = self.truth_at(name, times)
+            ends, known_ends = self.truth_at("work", times)
+            for index, (_, t, seen) in enumerate(items):
+                if known_starts[index] and known_ends[index]:
+                    colour = f.VISIBLE_COLOUR if seen else f.BLOCKED_COLOUR
+                    line = np.vstack([starts[index], ends[index]])
+                    out.strips[f.sight_path(name)].add(t, line, colour)
+
+    def _split(self, items: list, needs, final: bool) -> tuple[list, list]:
+        """(ready, still waiting) of items (name, time, value) whose truth has come."""
+        ready, waiting = [], []
+        for item in items:
+            (ready if self.ready(needs(item), item[1], final) else waiting).append(item)
+        return ready, waiting
+
+
+def _by_name(items: list[tuple]) -> dict[str, list[tuple]]:
+    grouped: dict[str, list[tuple]] = {}
+    for item in items:
+        grouped.setdefault(item[0], []).append(item)
+    return grouped

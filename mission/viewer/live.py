@@ -4,7 +4,8 @@ The orchestrator calls :meth:`LiveView.poll` from its supervision loop; each cal
 the ground station has added to its files since the last (the same reading as the replay, so
 the live view and ``mission view`` show the same rows) and streams it. Rerun is imported, and
 its recording (with its threads) made, only at the first poll: by then every vehicle has been
-forked, which a process with threads may not do.
+forked, which a process with threads may not do. The viewer and this process then run at a
+lower priority than the mission's processes.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from mission.config.settings import Scenario
 from mission.viewer.feed import RunFeed
 from mission.viewer.process import ViewerProcess, stop_viewer
 
-POLL_EVERY_S = 0.25  # wall seconds between two reads of the run's files
+POLL_EVERY_S = 0.5  # wall seconds between two reads of the run's files
+NICENESS = 10  # the view yields the CPU to the vehicles and the ground station
 
 
 class LiveView:
@@ -45,7 +47,11 @@ class LiveView:
             return
         self._last = now
         if self._rec is None:
+            import os
+
             from mission.viewer.recording import open_recording
+
+            os.nice(NICENESS)  # every child is started by now: this process alone
 
             self._feed = RunFeed(self.out_dir, self.scenario)
             url = self.viewer.grpc_url if self.viewer else None
@@ -60,11 +66,18 @@ class LiveView:
     def finish(self) -> None:
         """The run is over: stream the rest and complete the recording."""
         self.poll(final=True)
-        from mission.viewer.recording import close_recording
-
-        close_recording(self._rec)
+        self._close_recording()
 
     def close(self) -> None:
-        """Stop the viewer (after :func:`~mission.viewer.replay.wait_for_viewer`, if wanted)."""
+        """Complete the recording if the run did not (interrupted), then stop the viewer
+        (after :func:`~mission.viewer.replay.wait_for_viewer`, if wanted)."""
+        self._close_recording()
         if self.viewer is not None:
             stop_viewer(self.viewer)
+
+    def _close_recording(self) -> None:
+        if self._rec is not None:
+            from mission.viewer.recording import close_recording
+
+            close_recording(self._rec)
+            self._rec = None

@@ -28,6 +28,7 @@ from mission.procs.cli_common import die_with_parent
 
 LOOPBACK = "127.0.0.1"
 START_TIMEOUT_S = 30.0
+VIEWER_NICENESS = 10
 _GRPC = re.compile(r"Listening for gRPC connections on ([\d.]+):(\d+)")
 _WEB = re.compile(r"Hosting a web-viewer at (http://[\d.]+:\d+)")
 
@@ -110,7 +111,7 @@ def start_viewer(kind: Literal["web", "native"], log: Path | None = None) -> Vie
             stdout=handle,
             stderr=subprocess.STDOUT,
             env=viewer_environment(),
-            preexec_fn=die_with_parent,  # (before any thread of Rerun's: see live.py)
+            preexec_fn=_as_viewer_child,
         )
     viewer = ViewerProcess(process, "", None, log, temporary)
     try:
@@ -119,6 +120,13 @@ def start_viewer(kind: Literal["web", "native"], log: Path | None = None) -> Vie
         stop_viewer(viewer)
         raise
     return viewer
+
+
+def _as_viewer_child() -> None:
+    """In the viewer's process before it starts: die with this one; yield the CPU to the
+    mission's processes (the live view must not slow them)."""
+    die_with_parent()
+    os.nice(VIEWER_NICENESS)
 
 
 def _await_listening(viewer: ViewerProcess, web: bool) -> None:

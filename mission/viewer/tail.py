@@ -29,6 +29,8 @@ VIEWED_IDS = frozenset(
         mavlink2.MAVLINK_MSG_ID_LANDING_TARGET,
     }
 )
+STATION_SYSTEM_ID = 255  # the ground station's packets (requests, commands) are skipped
+SYSTEM_TIME_ID = mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME
 _SNAPSHOT = re.compile(r"^G_(\d+|initial|final)\.npy$")
 
 
@@ -39,6 +41,7 @@ class TlogTail:
         self.path = path
         self._offset = 0
         self._parser = mavlink2.MAVLink(None)
+        self._station_tick_seen = False
 
     def read(self) -> list[Any]:
         """The new messages, each with its ``_timestamp`` (seconds of the tlog's clock)."""
@@ -53,12 +56,17 @@ class TlogTail:
         self._offset += end if clean else len(data)
         messages = []
         for usec, packet in records:
+            station = packet[5] == STATION_SYSTEM_ID  # its own: only its first clock tick
+            if station and (self._station_tick_seen or _message_id(packet) != SYSTEM_TIME_ID):
+                continue
             try:
                 message = self._parser.decode(bytearray(packet))
             except mavlink2.MAVError:
                 continue
             message._timestamp = usec * 1.0e-6
             messages.append(message)
+            if packet[5] == STATION_SYSTEM_ID and message.time_boot_ms > 0:
+                self._station_tick_seen = True  # lockstep: the view needs no more of these
         return messages
 
 
@@ -119,6 +127,10 @@ class SnapshotTail:
                 found.append((label, values))
         order = {"initial": -1, "final": float("inf")}
         return sorted(found, key=lambda item: order.get(item[0]) or int(item[0]))
+
+
+def _message_id(packet: bytes) -> int:
+    return int.from_bytes(packet[7:10], "little")
 
 
 def _load(path: Path, shape: tuple[int, ...]) -> np.ndarray | None:
