@@ -176,14 +176,11 @@ def _wanted_records(data: bytes) -> list[tuple[int, bytes]] | None:
     return records if clean and end == len(data) else None
 
 
-def scan_records(
-    data: bytes, wanted: frozenset[int], start: int = 0
-) -> tuple[list[tuple[int, bytes]], int, bool]:
-    """The (microseconds, packet) records of the ``wanted`` message ids in ``data`` from
-    ``start``; the offset just past the last whole record; and whether everything up to it
-    was well-formed MAVLink 2 (a cut record at the end is not an error: a tlog still being
-    written ends in one)."""
-    records, offset, end = [], start, len(data)
+def scan_records(data: bytes, wanted: frozenset[int]) -> tuple[list[tuple[int, bytes]], int, bool]:
+    """The (microseconds, packet) records of the ``wanted`` message ids in ``data``; the offset
+    just past the last whole record; and whether everything up to it was well-formed MAVLink 2
+    (a cut record at the end is not an error: a tlog still being written ends in one)."""
+    records, offset, end = [], 0, len(data)
     while offset < end:
         begin = offset + 8
         if begin + 10 > end:

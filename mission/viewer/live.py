@@ -10,6 +10,8 @@ lower priority than the mission's processes.
 
 from __future__ import annotations
 
+import os
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -39,26 +41,32 @@ class LiveView:
         self._feed: RunFeed | None = None
         self._rec: Any = None
         self._last = float("-inf")
+        self._failed = False
 
     def poll(self, final: bool = False) -> None:
-        """Stream what is new (at most every POLL_EVERY_S, unless ``final``)."""
+        """Stream what is new (at most every POLL_EVERY_S, unless ``final``). A view that
+        fails says so once on stderr and stops; the run goes on (its files are its record)."""
         now = time.monotonic()
-        if not final and now - self._last < POLL_EVERY_S:
+        if self._failed or (not final and now - self._last < POLL_EVERY_S):
             return
         self._last = now
-        if self._rec is None:
-            import os
+        try:
+            self._stream(final)
+        except Exception as error:  # the view must never end the mission
+            self._failed = True
+            print(f"live view stopped: {error}", file=sys.stderr, flush=True)
 
+    def _stream(self, final: bool) -> None:
+        if self._feed is None:
+            os.nice(NICENESS)  # every child is started by now: this process alone
+            self._feed = RunFeed(self.out_dir, self.scenario)
+        if self._rec is None:
             from mission.viewer.recording import open_recording
 
-            os.nice(NICENESS)  # every child is started by now: this process alone
-
-            self._feed = RunFeed(self.out_dir, self.scenario)
             url = self.viewer.grpc_url if self.viewer else None
             self._rec = open_recording(self.out_dir.name, self._feed.scene, url, self.save)
         from mission.viewer.send import send_frame
 
-        assert self._feed is not None
         frame = self._feed.read(final)
         if frame:
             send_frame(self._rec, frame, self._feed.scene)
@@ -79,5 +87,8 @@ class LiveView:
         if self._rec is not None:
             from mission.viewer.recording import close_recording
 
-            close_recording(self._rec)
-            self._rec = None
+            rec, self._rec = self._rec, None
+            try:
+                close_recording(rec)
+            except Exception as error:  # as in poll: never at the run's expense
+                print(f"live view stopped: {error}", file=sys.stderr, flush=True)
