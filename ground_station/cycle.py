@@ -3,9 +3,10 @@
 1. localize: each support's GNSS fix p_n and camera observation r_n (brought to the cycle's
    time, :mod:`~ground_station.align`), with covariances;
 2. fuse: selective fusion for the work UAV's xhat, feedback for each support's yhat_n;
-3. check arrival at the current work waypoint (|w_k - xhat| < 0.1 m advances k);
+3. check arrival at the current work waypoint (|w_k - xhat| < 0.1 m advances k; not when
+   blind);
 4. learn: G updated around each yhat_n with the GNSS error seen there (AC only);
-5. plan: the work UAV's path (Algorithm 1), then each support's MPC around it.
+5. plan: the work UAV's path (Algorithm 1; blind, it holds), then each support's MPC around it.
 
 :func:`control_cycle` runs the five steps up to the work UAV's plan; :func:`complete_cycle`
 then poses and solves the supports' MPCs. The ground station sends the work UAV its command
@@ -76,9 +77,10 @@ def control_cycle(
     control = models.scenario.control
     measurements = localize(align(reports, state, control.t_cont_s), models.world)  # 1
     fusion, betas = fuse(state, measurements, models.scenario.fusion, models.rng)  # 2
-    arrived = check_arrival(state, models.work_waypoints, control.arrival_tol_m)  # 3
+    blind = fusion.blind  # no waypoint is reached on a dead-reckoned estimate
+    arrived = None if blind else check_arrival(state, models.work_waypoints, control.arrival_tol_m)
     updated = learn(models.g, measurements, state.yhat)  # 4
-    formation = plan(state, models, [m.name for m in measurements])  # 5
+    formation = plan(state, models, [m.name for m in measurements], hold=blind)  # 5
     elapsed_ms = (time.perf_counter() - start) * 1000
     return CycleDecision(measurements, fusion, betas, arrived, updated, formation, elapsed_ms)
 

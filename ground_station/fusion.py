@@ -103,12 +103,13 @@ def fuse(
     rng: np.random.Generator,
 ) -> tuple[FusionResult, dict[str, float | None]]:
     """Step 2 of the control cycle: selective fusion for xhat around the position predicted
-    from the last command, then feedback to each support's yhat_n; updates ``state`` and
-    returns the fusion and each support's beta_n."""
+    from the last command (blind: xhat becomes that prediction), then feedback to each
+    support's yhat_n; updates ``state`` and returns the fusion and each support's beta_n."""
     predicted = state.xhat + state.last_work_command
     fusion = selective_fusion(supports, predicted, settings, rng)
-    if fusion.xhat is not None:
-        state.xhat = fusion.xhat
+    # Blind, the work UAV's estimate is dead-reckoned: where its last command took it (the
+    # position its autopilot believes, which it then holds: ground_station.plan).
+    state.xhat = predicted if fusion.xhat is None else fusion.xhat
     betas: dict[str, float | None] = {}
     for support in supports:
         previous = state.yhat[support.name]

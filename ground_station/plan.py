@@ -14,7 +14,7 @@ from ground_station.localizability import hermite_zero_slope
 from ground_station.models import Models
 from ground_station.state import StationState, reachable
 from ground_station.support_mpc import PlanRequest, SupportPlan
-from ground_station.work_mpc import WorkPrediction, predict_work
+from ground_station.work_mpc import WorkPrediction, hold_work, predict_work
 
 ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape starts too
 
@@ -27,18 +27,27 @@ class FormationPlan:
     supports: tuple[str, ...]
 
 
-def plan(state: StationState, models: Models, supports: Sequence[str]) -> FormationPlan:
+def plan(
+    state: StationState, models: Models, supports: Sequence[str], hold: bool = False
+) -> FormationPlan:
     """The work UAV's path from xhat (its command is the first point), for ``supports`` to
-    plan around; records the work UAV's commanded displacement in ``state``."""
+    plan around; records the work UAV's commanded displacement in ``state``.
+
+    ``hold`` (a blind cycle: no support contributed): the work UAV holds where its last
+    command took it (xhat, dead-reckoned there by the fusion) for the whole horizon, so the
+    supports plan around a work UAV that stays put and regain sight of it."""
     control = models.scenario.control
-    work = predict_work(
-        state.xhat,
-        state.k,
-        models.work_waypoints,
-        control.horizon_steps,
-        control.d_max_work_m,
-        control.arrival_tol_m,
-    )
+    if hold:
+        work = hold_work(state.xhat, state.k, control.horizon_steps)
+    else:
+        work = predict_work(
+            state.xhat,
+            state.k,
+            models.work_waypoints,
+            control.horizon_steps,
+            control.d_max_work_m,
+            control.arrival_tol_m,
+        )
     reach = control.s_max_work_m_s * control.t_cont_s
     state.last_work_command = reachable(state.xhat, work.command, reach)
     return FormationPlan(work, tuple(supports))

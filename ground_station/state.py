@@ -20,6 +20,7 @@ class StationState:
     last_support_command: dict[str, np.ndarray] = field(default_factory=dict)
     warm: dict[str, np.ndarray] = field(default_factory=dict)
     completed: bool = False
+    blind_cycles: int = 0  # consecutive cycles with no estimate of the work UAV, up to now
 
     def forget(self, support: str) -> None:
         """Drop what was carried for a support that fell silent and is back."""

@@ -162,7 +162,9 @@ class GroundStation:
         supports' MPCs are solved: it steps meanwhile, and its truth is there when the supports
         step. Returns the step its tick starts (None: no tick went out)."""
         links, work = self.links, self.links.views["work"]
-        links.queue_for(vision_position_estimate(state.xhat, self.clock.time_usec), work)
+        if not decision.fusion.blind:  # blind, it navigates on its own dead reckoning
+            links.queue_for(vision_position_estimate(state.xhat, self.clock.time_usec), work)
+        self._announce_sight(state, decision.fusion.blind)
         time_ms = round(self.clock.time_s * 1000)
         links.queue_for(position_target(decision.work_command, time_ms, work.system_id), work)
         if decision.arrived is not None and not state.completed:
@@ -173,6 +175,14 @@ class GroundStation:
             links.queue_for(step.tick, work)
         links.flush(work)
         return step
+
+    def _announce_sight(self, state: StationState, blind: bool) -> None:
+        """STATUSTEXT when the work UAV goes blind (it holds) and when it is seen again."""
+        if blind and state.blind_cycles == 0:
+            self.links.announce("Work UAV blind: holding")
+        elif not blind and state.blind_cycles > 0:
+            self.links.announce(f"Work UAV seen again after {state.blind_cycles} blind cycles")
+        state.blind_cycles = state.blind_cycles + 1 if blind else 0
 
     def _command_supports(self, state: StationState, output: CycleOutput) -> None:
         time_ms = round(self.clock.time_s * 1000)

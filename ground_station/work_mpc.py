@@ -43,3 +43,9 @@ def predict_work(
         if np.linalg.norm(waypoints[k] - v) < arrival_tol_m and k < last:
             k += 1
     return WorkPrediction(np.array(path), np.array(indices))
+
+
+def hold_work(position: np.ndarray, k_now: int, horizon: int) -> WorkPrediction:
+    """The work UAV holding at ``position`` over the horizon (a blind cycle)."""
+    path = np.repeat(np.asarray(position, dtype=float).reshape(1, 3), horizon + 1, axis=0)
+    return WorkPrediction(path, np.full(horizon + 1, k_now))

@@ -41,6 +41,7 @@ class VehicleSettings:
     """
 
     tracking_noise_m: float
+    radius_m: float
     failsafe_s: float
     heartbeat_hz: float
     status_hz: float
@@ -53,6 +54,7 @@ class VehicleSettings:
 
     def __post_init__(self) -> None:
         _non_negative(self, "tracking_noise_m")
+        _positive(self, "radius_m")
         _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
         _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
         _require(self.mission_retries >= 0, "mission_retries", "must not be negative")

@@ -255,9 +255,12 @@ class ControlSettings:
     los_penalty: Literal["visible-point", "paper"]
     mpc_solver: Literal["fatrop", "ipopt"]
     escape_starts: bool  # where G has risen, also start the support MPC from escaping paths
+    min_separation_m: float  # between any two UAVs over the MPCs' horizon (0: no margin)
+    clearance_m: float  # from the structure and the ground over the horizon (0: no margin)
 
     def __post_init__(self) -> None:
         _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
+        _non_negative(self, "min_separation_m", "clearance_m")
         _positive(self, "t_pred_s", "t_cont_s", "s_max_work_m_s", "s_max_support_m_s")
         _positive(self, "arrival_tol_m", "support_max_sigma0_m")
         _non_negative(self, "w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")
@@ -275,10 +278,12 @@ class ControlSettings:
 
 @dataclass(frozen=True)
 class RunSettings:
-    """How a run goes: its time limit and the simulated epoch of t = 0."""
+    """How a run goes: its time limit, the simulated epoch of t = 0, and whether a crash
+    ends it."""
 
     timeout_s: float
     epoch_utc: str
+    stop_on_crash: bool  # a contact ends the run as failed (false: recorded, flies on)
 
     def __post_init__(self) -> None:
         _positive(self, "timeout_s")
@@ -332,7 +337,25 @@ class Scenario:
     limits: LimitSettings
 
     def __post_init__(self) -> None:
+        self._check_margins()
         for i, point in enumerate(self.task.work_waypoints_m):
             box = self.world.workspace
             inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))
             _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")
+
+    def _check_margins(self) -> None:
+        """A margin, where there is one, leaves room for the bodies it keeps apart."""
+        radius = self.vehicle.radius_m
+        separation, clearance = self.control.min_separation_m, self.control.clearance_m
+        _require(
+            separation == 0 or separation >= 2 * radius,
+            "control.min_separation_m",
+            f"{separation:g} m is less than two bodies' radii (2 x vehicle.radius_m = "
+            f"{2 * radius:g} m); 0 turns the margin off",
+        )
+        _require(
+            clearance == 0 or clearance >= radius,
+            "control.clearance_m",
+            f"{clearance:g} m is less than a body's radius (vehicle.radius_m = {radius:g} m); "
+            "0 turns the margin off",
+        )

@@ -57,7 +57,8 @@ def run_detached(
         output = run_cycle(state, reports, models)
         outputs.append(output)
         truth.append(work_truth.copy())
-        vehicles["work"].set_estimate(state.xhat)
+        if not output.fusion.blind:  # blind, the work UAV holds on its own dead reckoning
+            vehicles["work"].set_estimate(state.xhat)
         vehicles["work"].target = output.work_target
         for name, target in output.support_targets.items():
             vehicles[name].set_estimate(state.yhat[name])
