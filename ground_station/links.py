@@ -68,6 +68,7 @@ class VehicleView:
     late: bool = False  # missed the last lockstep marker: not waited for
     outbox: list[tuple[Any, bytes]] = field(default_factory=list)  # (message, packet) unsent
     last_batch: list[Any] = field(default_factory=list)  # the messages last sent together
+    crash: str | None = None  # the vehicle's own word that it crashed (its STATUSTEXT)
 
 
 class VehicleLinks:
@@ -164,6 +165,8 @@ class VehicleLinks:
         if kind not in TRUTH_KINDS:
             view.latest[kind] = message
         view.heard_s = self.clock.time_s
+        if kind == "STATUSTEXT" and message.text.startswith("Crash:") and view.crash is None:
+            view.crash = message.text
         if kind == "HEARTBEAT":
             view.heartbeat_wall = time.monotonic()
         elif kind == "SYSTEM_TIME":

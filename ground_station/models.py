@@ -46,7 +46,7 @@ def build_models(
         sigma0 = world.sigma0_map().sigma_m
     g = LocalizabilityMap(grid, sigma0, scn.map, adaptive)
     supports = {n: w for n, w in waypoints.items() if n != "work"}
-    mpc = SupportMpc(scn.control, grid, world.camera, g.initial)
+    mpc = SupportMpc(scn.control, grid, world.camera, g.initial, others=scn.task.supports)
     observable = world.camera.observable
     planner = (
         LocalPlanner(mpc, observable) if helper is None else HelperPlanner(mpc, observable, helper)

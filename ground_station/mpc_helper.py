@@ -57,7 +57,9 @@ def serve(requests: BinaryIO, answers: BinaryIO) -> None:
     except EOFError:
         return
     world = KnownWorld(scenario)
-    mpc = SupportMpc(scenario.control, world.map_grid(), world.camera, sigma0)
+    mpc = SupportMpc(
+        scenario.control, world.map_grid(), world.camera, sigma0, others=scenario.task.supports
+    )
     freeze_startup_heap()
     while True:
         try:

@@ -10,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ground_station.localizability import hermite_zero_slope
 from ground_station.models import Models
 from ground_station.state import StationState, reachable
@@ -33,8 +35,9 @@ def plan(
     """The work UAV's path from xhat (its command is the first point), for ``supports`` to
     plan around; records the work UAV's commanded displacement in ``state``.
 
-    ``hold`` (a blind cycle: no support contributed): the work UAV holds where its last
-    command took it (xhat, dead-reckoned there by the fusion) for the whole horizon, so the
+    The work UAV waits (holds) where its next step would break a margin
+    (:func:`work_must_wait`). ``hold`` (a blind cycle: no support contributed): it holds where
+    its last command took it (xhat, dead-reckoned there by the fusion) for the whole horizon, so the
     supports plan around a work UAV that stays put and regain sight of it."""
     control = models.scenario.control
     if hold:
@@ -48,9 +51,28 @@ def plan(
             control.d_max_work_m,
             control.arrival_tol_m,
         )
+    if not hold and work_must_wait(state, work.command, models):
+        work = hold_work(state.xhat, state.k, control.horizon_steps)
     reach = control.s_max_work_m_s * control.t_cont_s
     state.last_work_command = reachable(state.xhat, work.command, reach)
     return FormationPlan(work, tuple(supports))
+
+
+def work_must_wait(state: StationState, command: np.ndarray, models: Models) -> bool:
+    """Whether the work UAV's next step would bring it inside a margin it is not already
+    inside, closer: within the separation of a support's estimate, or within the clearance
+    of the structure or the ground. It then waits for the supports to give way."""
+    control = models.scenario.control
+    if control.min_separation_m > 0:
+        for yhat in state.yhat.values():
+            after = float(np.linalg.norm(command - yhat))
+            if after < control.min_separation_m and after < np.linalg.norm(state.xhat - yhat):
+                return True
+    if control.clearance_m > 0:
+        proximity = models.support_mpc.margins.proximity
+        after, now = proximity.clearance(np.vstack([command, state.xhat]))
+        return bool(after < control.clearance_m and after < now)
+    return False
 
 
 def solve_supports(
@@ -89,4 +111,23 @@ def support_request(
         g.values,
         state.warm.get(name),
         escape=escape,
+        others=others_predicted(state, name, work, models.scenario.control.horizon_steps),
     )
+
+
+def others_predicted(
+    state: StationState, name: str, work: WorkPrediction, horizon: int
+) -> np.ndarray:
+    """(m, U, 3): where the other UAVs are predicted at a support's steps: the work UAV on its
+    path, each other support on its last plan shifted by a step (held at its estimate before
+    it has one)."""
+    others = [work.path[:horizon]]
+    for other, yhat in state.yhat.items():
+        if other == name:
+            continue
+        warm = state.warm.get(other)
+        if warm is None:
+            others.append(np.repeat(yhat[None], horizon, axis=0))
+        else:
+            others.append(np.vstack([warm[1:], warm[-1:]]))
+    return np.array(others)

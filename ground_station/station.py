@@ -74,6 +74,7 @@ class GroundStation:
             config.vehicles, self.clock, self.tlog, config.signing_key, config.link, config.seed
         )
         self.cycles = 0
+        self.stopped: str | None = None  # why the run ended before its task (a crash)
         self.models: Models | None = None
         self._helper: MpcHelper | None = None
 
@@ -90,6 +91,7 @@ class GroundStation:
         return {
             "completed": completion is not None,
             "completion_time_s": completion,
+            "stopped": self.stopped,
             "control_cycles": self.cycles,
             "sim_time_s": self.clock.time_s,
             "wall_time_s": time.monotonic() - start_wall,
@@ -127,6 +129,8 @@ class GroundStation:
             if not self.clock.lockstep:  # each vehicle's clock, for its measurements' ages
                 self.links.sync_clocks()
             await_step(self.links, self.clock, pending, self.timing)
+            if self._crashed():
+                return None
             for name in self.links.supervise(self.config.link_loss_s, self.clock.step_s):
                 state.forget(name)
             reports = reports_from_messages(self.links.support_samples(), self.frame)
@@ -143,6 +147,16 @@ class GroundStation:
                 self.links.announce(f"Mission complete at {self.clock.time_s:.1f} s")
                 return self.clock.time_s
         return None
+
+    def _crashed(self) -> bool:
+        """A vehicle said it crashed and the run stops on crashes: the run ends, failed."""
+        crashes = [(v.name, v.crash) for v in self.links.views.values() if v.crash]
+        if not crashes or not self.scenario.run.stop_on_crash:
+            return False
+        name, text = crashes[0]
+        self.stopped = f"{name} crashed ({text})"
+        self.links.announce(f"Run stopped: {name} crashed", to_stderr=True)
+        return True
 
     def _start_step(self, step: PendingStep | None, work_ticked: bool = False):
         """Start ``step`` (None: none is left): in lockstep the clock advances and each

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ground_station.los_anchors import LosAnchors
+from ground_station.margins import Margins
 from ground_station.support_nlp import build_support_nlp
 from mission.config.resources import mpc_window_shape
 from mission.config.settings import ControlSettings
@@ -48,6 +49,7 @@ class PlanRequest:
     window: np.ndarray
     warm_start: np.ndarray | None
     escape: bool
+    others: np.ndarray | None = None  # (m, U, 3): the other UAVs' predicted positions
 
 
 @dataclass(frozen=True)
@@ -83,9 +85,11 @@ class SupportMpc:
         camera: CameraModel,
         sigma0: np.ndarray | None = None,
         compiled: bool = True,
+        others: int = 0,
     ) -> None:
-        """``compiled=False``: casadi interprets the NLP, even with a C compiler (slower, the
-        same plans)."""
+        """``others``: how many other UAVs a support keeps its separation from (the work UAV
+        and the other supports); ``compiled=False``: casadi interprets the NLP, even with a C
+        compiler (slower, the same plans)."""
         self.control = control
         self.grid = grid
         self.camera = camera
@@ -96,7 +100,12 @@ class SupportMpc:
         self.window = mpc_window_shape(control, grid.voxel_m, grid.shape)
         self._window_grid = VoxelGrid(np.zeros(3), grid.voxel_m, self.window)
         with_prior = sigma0 is not None
-        nlp = build_support_nlp(control, self._window_grid, with_prior, compiled)
+        structure = camera.structure
+        if structure is None:
+            raise ValueError("the support MPC needs the camera's structure for its margins")
+        self.margins = Margins(control, structure, others)
+        slots = self.margins.slots
+        nlp = build_support_nlp(control, self._window_grid, with_prior, compiled, slots)
         self._solvers, self._cost = nlp.solvers, nlp.cost
         self._anchors = LosAnchors(control, camera, grid, self.sigma0)
         d_max_sq = control.d_max_support_m**2
@@ -104,9 +113,10 @@ class SupportMpc:
         shadow = np.full(0 if sigma0 is None else self.horizon, control.support_max_sigma0_m)
         # Near keeps the terminal strictly inside d_max, so xi's lower weight applies to it;
         # far has no terminal constraint.
+        margins = np.zeros(self.horizon * slots + (self.horizon if slots else 0))
         self._upper_bounds = {
-            "near": np.concatenate([steps, [d_max_sq * (1 - 1e-6)], shadow]),
-            "far": np.concatenate([steps, shadow]),
+            "near": np.concatenate([steps, [d_max_sq * (1 - 1e-6)], shadow, margins]),
+            "far": np.concatenate([steps, shadow, margins]),
         }
 
     def window_of(self, yhat: np.ndarray, g_values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -153,8 +163,10 @@ class SupportMpc:
         g_values: np.ndarray,
         warm_start: np.ndarray | None = None,
         escape: bool = False,
+        others: np.ndarray | None = None,
     ) -> PlanRequest:
-        """Everything one support's solve needs, G cut down to the window around yhat."""
+        """Everything one support's solve needs, G cut down to the window around yhat;
+        ``others`` (m, U, 3): the other UAVs' predicted positions, for the separation."""
         horizon = self.horizon
         corner, window = self.window_of(yhat, g_values)
         return PlanRequest(
@@ -167,6 +179,7 @@ class SupportMpc:
             window,
             warm_start,
             escape,
+            others,
         )
 
     def plan(self, request: PlanRequest, observable) -> SupportPlan:
@@ -184,7 +197,8 @@ class SupportMpc:
         start = time.perf_counter()
         blocked = ~observable(guess, work)
         anchors = self.anchors(guess, work, targets, blocked)
-        flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window])
+        margins = self._margin_parameters(request, guess)
+        flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window, margins])
         path, status, cost = self._solve_once(fixed, flags, guess)
         if request.escape:  # G_s is flat at voxel centres: also start from paths leaving each way
             for candidate in self._escape_guesses(yhat, fixed, flags):
@@ -196,10 +210,18 @@ class SupportMpc:
         if np.any(after != blocked):
             blocked, resolved = blocked | after, True  # blocked either way: held blocked
             anchors = self.anchors(path, work, targets, blocked)
-            flags = np.concatenate([anchors.ravel(), blocked.astype(float), corner, window])
+            margins = self._margin_parameters(request, path)
+            flags = np.concatenate(
+                [anchors.ravel(), blocked.astype(float), corner, window, margins]
+            )
             path, status, _ = self._solve_once(fixed, flags, path)
         elapsed = (time.perf_counter() - start) * 1000
         return SupportPlan(path, status, elapsed, blocked, resolved, anchors)
+
+    def _margin_parameters(self, request: PlanRequest, guess: np.ndarray) -> np.ndarray:
+        """The margins' half-spaces linearised at ``guess`` (none without margins)."""
+        others = np.zeros((0, self.horizon, 3)) if request.others is None else request.others
+        return self.margins.parameters(guess, request.yhat, others)
 
     def _initial_guess(
         self, yhat: np.ndarray, terminal: np.ndarray, warm_start: np.ndarray | None
@@ -232,13 +254,17 @@ class SupportMpc:
         c = self.control
         solver = self._solvers[branch]
         weight = c.w_interval if branch == "near" else c.w_penalty
+        x0 = guess.ravel()
+        if self.margins.slots:  # the slacks start at each step's violation of its margins
+            count = self.horizon * self.margins.slots * 4
+            x0 = np.concatenate([x0, self.margins.slack_guess(guess, flags[-count:]) + 1e-3])
         result = solver(
-            x0=guess.ravel(),
+            x0=x0,
             p=np.concatenate([fixed, [weight], flags]),
             ubg=self._upper_bounds[branch],
         )
         status = solver.stats()["unified_return_status"]
-        path = result["x"].reshape(self.horizon, 3)
+        path = result["x"][: 3 * self.horizon].reshape(self.horizon, 3)
         terminal_sq = float(np.sum((self._terminal_of(fixed) - path[-1]) ** 2))
         cost = float(result["f"][0]) + (self._xi_weight(terminal_sq) - weight) * terminal_sq
         return path, status, cost

@@ -8,6 +8,13 @@ Decision variables: the U predicted positions V'_n. Cost, exactly the paper's fo
   C_waypoint = sum_u w_waypoint |v_u - w_{n,k_u}|^2
   C_relative = sum_u (w_relative, or w_penalty if not observable) |v^(w)_u - v_u|^2
 
+With margins (``control.min_separation_m`` or ``control.clearance_m`` above zero), each step
+u must also lie in ``slots`` half-spaces n.v_u >= b (the other UAVs' and the structure's,
+linearised at the guess: :mod:`ground_station.margins`), as an exact L1 penalty: one slack
+s_u >= 0 per step relaxes every half-space of that step, at MARGIN_WEIGHT per metre in the
+cost. The problem is always feasible, and where the margins can be kept the slacks are zero
+(the weight exceeds any multiplier the other terms can produce).
+
 Each step is also bounded hard by d_max (the vehicle cannot fly faster), where xi is exactly
 w_interval d^2; the terminal link keeps the jump at d_max, which the solver sees as two smooth
 NLPs, *near* (|w - v_U| <= d_max, weight w_interval) and *far* (weight w_penalty): see
@@ -56,6 +63,7 @@ FATROP_OPTIONS = {
     "fatrop": {"print_level": 0, "tol": 1e-4, "max_iter": 50, "bound_push": 1e-3},
 }
 SOLVER_OPTIONS = {"fatrop": FATROP_OPTIONS, "ipopt": IPOPT_OPTIONS}
+MARGIN_WEIGHT = 1.0e4  # cost per metre of a margin's violation (the exact penalty's weight)
 
 
 @dataclass(frozen=True)
@@ -73,10 +81,14 @@ class NlpSymbols:
     prior: ca.MX  # sigma_0 over the window (empty without the shadow constraint)
     corner: ca.MX  # the window's corner, world coordinates
     terminal_weight: ca.MX  # xi's weight on the branch being solved
+    normals: ca.MX  # (3, U slots) the margins' half-spaces n.v_u >= b, step by step
+    offsets: ca.MX  # (U slots,) their b
+    slack: ca.MX  # (U,) how far each step may break its margins (empty without margins)
 
     @classmethod
-    def make(cls, horizon: int, n_window: int, with_prior: bool) -> NlpSymbols:
-        """Fresh symbols for a horizon of U steps and a window of ``n_window`` voxels."""
+    def make(cls, horizon: int, n_window: int, with_prior: bool, slots: int = 0) -> NlpSymbols:
+        """Fresh symbols for a horizon of U steps, a window of ``n_window`` voxels and
+        ``slots`` margin half-spaces per step."""
         sym = ca.MX.sym
         return cls(
             v=sym("v", 3, horizon),
@@ -90,6 +102,9 @@ class NlpSymbols:
             prior=sym("sigma0", n_window if with_prior else 0),
             corner=sym("corner", 3),
             terminal_weight=sym("w_terminal"),
+            normals=sym("n", 3, horizon * slots),
+            offsets=sym("b", horizon * slots),
+            slack=sym("s", horizon if slots else 0),
         )
 
     def parameters(self) -> ca.MX:
@@ -105,7 +120,26 @@ class NlpSymbols:
             self.corner,
             self.values,
             self.prior,
+            *([ca.vec(self.normals), self.offsets] if self.offsets.shape[0] else []),
         )
+
+    def variables(self) -> ca.MX:
+        """The decision variables: the path, then the margins' slacks (if any)."""
+        if self.slack.shape[0] == 0:
+            return ca.vec(self.v)
+        return ca.vertcat(ca.vec(self.v), self.slack)
+
+    def margin_rows(self, slots: int) -> list[ca.MX]:
+        """b - n.v_u - s_u <= 0 for every half-space, then -s_u <= 0."""
+        horizon = self.v.shape[1]
+        rows = [
+            self.offsets[u * slots + j]
+            - ca.dot(self.normals[:, u * slots + j], self.v[:, u])
+            - self.slack[u]
+            for u in range(horizon)
+            for j in range(slots)
+        ]
+        return rows + [-self.slack[u] for u in range(self.slack.shape[0])]
 
 
 @dataclass(frozen=True)
@@ -117,12 +151,17 @@ class SupportNlp:
 
 
 def build_support_nlp(
-    control: ControlSettings, window: VoxelGrid, with_prior: bool, compiled: bool = True
+    control: ControlSettings,
+    window: VoxelGrid,
+    with_prior: bool,
+    compiled: bool = True,
+    slots: int = 0,
 ) -> SupportNlp:
-    """The NLP over a window of voxels, its functions compiled when a C compiler is there (and
-    ``compiled`` asks for it; else casadi interprets them: the same plans, slower)."""
+    """The NLP over a window of voxels with ``slots`` margin half-spaces per step (none: the
+    paper's problem), its functions compiled when a C compiler is there (and ``compiled`` asks
+    for it; else casadi interprets them: the same plans, slower)."""
     horizon = control.horizon_steps
-    s = NlpSymbols.make(horizon, window.n_voxels, with_prior)
+    s = NlpSymbols.make(horizon, window.n_voxels, with_prior, slots)
     hermite = inlined_hermite(window)  # G_s and the prior's, per step
     cost = _cost(control, s, hermite)
     terminal_sq = ca.sumsqr(s.terminal - s.v[:, horizon - 1])
@@ -139,16 +178,19 @@ def build_support_nlp(
     cost_function = ca.Function(
         "support_mpc_cost", [ca.vec(s.v), parameters], [cost], ["x", "p"], ["f"]
     )
+    margins = s.margin_rows(slots) if slots else []
+    if slots:
+        cost += MARGIN_WEIGHT * ca.sum1(s.slack)
     # With an infinite bound on far's terminal row fatrop failed 99 of 1,220 recorded solves
     # and carried the failure into the solves after it (plans then depended on the order of
     # solving); without the row it solves them all, as IPOPT does. No bound of either branch
     # is infinite.
     constraints = {
-        "near": ca.vertcat(*steps, terminal_sq, *shadow),
-        "far": ca.vertcat(*steps, *shadow),
+        "near": ca.vertcat(*steps, terminal_sq, *shadow, *margins),
+        "far": ca.vertcat(*steps, *shadow, *margins),
     }
     nlps = {
-        b: {"x": ca.vec(s.v), "p": parameters, "f": cost, "g": g} for b, g in constraints.items()
+        b: {"x": s.variables(), "p": parameters, "f": cost, "g": g} for b, g in constraints.items()
     }
     solvers = _solvers(control.mpc_solver, nlps, compiled)
     return SupportNlp(solvers, BufferedFunction(cost_function, ("f",)))

@@ -53,6 +53,37 @@ TWO_ZONES = (
     " {{name: {name}, min_m: [2, 0, 1], max_m: [3, 1, 2], offset_m: [1, 0, 0]}}]}}\n"
 )
 CASES = [
+    # --- safety margins ----------------------------------------------------------------
+    (
+        "yaml-negative-margin",
+        lambda t: [*RUN, str(_scenario(t, "control: {clearance_m: -1}\n"))],
+        ["bad.yaml", "control.clearance_m", "must not be negative"],
+    ),
+    (
+        "yaml-negative-radius",
+        lambda t: [*RUN, str(_scenario(t, "vehicle: {radius_m: -0.1}\n"))],
+        ["bad.yaml", "vehicle.radius_m", "must be positive"],
+    ),
+    (
+        "yaml-separation-below-two-bodies",
+        lambda t: [*RUN, str(_scenario(t, "control: {min_separation_m: 0.3}\n"))],
+        ["bad.yaml", "control.min_separation_m", "two bodies' radii"],
+    ),
+    (
+        "yaml-clearance-below-a-body",
+        lambda t: [*RUN, str(_scenario(t, "control: {clearance_m: 0.1}\n"))],
+        ["bad.yaml", "control.clearance_m", "a body's radius"],
+    ),
+    (
+        "run-plan-breaks-separation",
+        lambda t: [*RUN, str(_scenario(t, "control: {min_separation_m: 3.5}\n"))],
+        ["support-1.waypoints", "item", "control.min_separation_m (3.5 m)"],
+    ),
+    (
+        "run-plan-breaks-clearance",
+        lambda t: [*RUN, str(_scenario(t, "control: {clearance_m: 1.5}\n"))],
+        ["work.waypoints", "item", "control.clearance_m (1.5 m)"],
+    ),
     # --- scenario YAML -----------------------------------------------------------------
     (
         "yaml-syntax",

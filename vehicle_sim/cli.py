@@ -74,7 +74,9 @@ def build_parser() -> OneLineArgumentParser:
         help="start position, ENU metres (default: first planned waypoint)",
     )
     parser.add_argument(
-        "--truth-port", type=int, help="support: port for the work UAV's truth (default port + 100)"
+        "--truth-port",
+        type=int,
+        help="port for the other vehicles' truth (simulation only; default port + 100)",
     )
     parser.add_argument(
         "--socket-fd",
@@ -87,14 +89,15 @@ def build_parser() -> OneLineArgumentParser:
         "--truth-socket-fd",
         type=int,
         metavar="FD",
-        help="support: the same for the truth port",
+        help="the same for the truth port",
     )
     parser.add_argument(
         "--truth-out",
         action="append",
         default=None,
         metavar="HOST:PORT",
-        help="work: send truth here (default: each support's default truth port)",
+        help="send this vehicle's truth here (repeatable; default: every other vehicle's "
+        "default truth port)",
     )
     add_link_arguments(parser)
     parser.add_argument(
@@ -153,8 +156,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 @dataclass
 class Channels:
-    """A vehicle's sockets: its MAVLink endpoint, and the truth channel's (the work UAV's
-    sender, a support's receiver)."""
+    """A vehicle's sockets: its MAVLink endpoint, and the truth channel's (its sender, its
+    receiver)."""
 
     endpoint: UdpEndpoint
     truth_sender: TruthSender | None = None
@@ -182,14 +185,13 @@ def _open_channels(
     supports: int,
 ) -> Channels:
     """Bind (or adopt) the vehicle's sockets."""
-    truth_sender = None
-    if identity.is_work:
-        if args.truth_out is None:
-            others = range(1, supports + 1) if port else range(0)
-            destinations = [(args.host, port + TRUTH_PORT_OFFSET + n) for n in others]
-        else:
-            destinations = [_address(text, "--truth-out") for text in args.truth_out]
-        truth_sender = TruthSender(identity.system_id, destinations)
+    if args.truth_out is None:  # every other vehicle's truth port, counted from ours
+        others = [m for m in range(supports + 1) if m != identity.instance] if port else []
+        base = port - identity.instance + TRUTH_PORT_OFFSET
+        destinations = [(args.host, base + m) for m in others]
+    else:
+        destinations = [_address(text, "--truth-out") for text in args.truth_out]
+    truth_sender = TruthSender(identity.system_id, destinations)
     sock = _inherited_socket(args.socket_fd, "--socket-fd")
     with _bind_error("--port", args.host, port, defaulted=args.port is None):
         endpoint = UdpEndpoint(
@@ -200,15 +202,16 @@ def _open_channels(
             sock=sock,
         )
     channels = Channels(endpoint, truth_sender)
-    if not identity.is_work:
-        truth_port = args.truth_port
-        if truth_port is None:
-            truth_port = port + TRUTH_PORT_OFFSET if port else 0
-        check_port(truth_port, "--truth-port", allow_any=True)
-        sock = _inherited_socket(args.truth_socket_fd, "--truth-socket-fd")
-        defaulted = args.truth_port is None
-        with _bind_error("--truth-port", args.host, truth_port, defaulted=defaulted):
-            channels.truth_receiver = TruthReceiver(truth_port, args.host, sock=sock)
+    truth_port = args.truth_port
+    if truth_port is None:
+        truth_port = port + TRUTH_PORT_OFFSET if port else 0
+    check_port(truth_port, "--truth-port", allow_any=True)
+    sock = _inherited_socket(args.truth_socket_fd, "--truth-socket-fd")
+    defaulted = args.truth_port is None
+    with _bind_error("--truth-port", args.host, truth_port, defaulted=defaulted):
+        channels.truth_receiver = TruthReceiver(
+            truth_port, args.host, sock=sock, own_system=identity.system_id
+        )
     return channels
 
 

@@ -55,6 +55,8 @@ def set_mode(vehicle: Vehicle, base_mode: int, custom_mode: int) -> int:
 def _arm(vehicle: Vehicle, params: list[float]) -> int:
     if params[0] not in (0.0, 1.0):
         return DENIED
+    if params[0] == 1.0 and vehicle.crashed:  # a crashed vehicle does not fly again
+        return DENIED
     vehicle.arm(params[0] == 1.0)
     return ACCEPTED
 

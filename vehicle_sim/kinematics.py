@@ -31,6 +31,13 @@ class Kinematics:
         """Hold where the autopilot believes it is."""
         self.target = self.believed.copy()
 
+    def stop_at(self, position: np.ndarray) -> None:
+        """Stopped dead at ``position`` (a crash): truth and belief there, no target."""
+        self.truth = np.asarray(position, dtype=float).reshape(3).copy()
+        self.believed = self.truth.copy()
+        self.target = None
+        self.velocity = np.zeros(3)
+
     def step(
         self, dt_s: float, speed_limit_m_s: float, rng: np.random.Generator, noise_m: float
     ) -> np.ndarray:

@@ -34,6 +34,7 @@ from typing import Any
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import Address, UdpEndpoint
+from mission.link.vehicle_identity import VehicleIdentity
 from mission.procs.wall_grid import next_grid_instant
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
@@ -227,15 +228,29 @@ class VehicleServer:
         now_ns = round((now - self._origin_wall) * self.clock.speedup * 1e9)
         vehicle.send(mavlink2.MAVLink_timesync_message(now_ns, message.ts1))
 
-    def _physical_usec(self) -> int:
-        """The physical time of the current step for the truth channel: simulated time in
-        lockstep, the host's wall clock at the step's nominal instant in real time."""
+    def _physical_usec(self, steps_back: int = 0) -> int:
+        """The physical time of the current step (or of one ``steps_back`` before it) for the
+        truth channel: simulated time in lockstep, the host's wall clock at the step's nominal
+        instant in real time."""
         vehicle = self.vehicle
         assert vehicle is not None
+        steps = vehicle.steps - steps_back
         if self.clock.lockstep:
-            return round(vehicle.sim_time_s * 1e6)
+            return round(steps * vehicle.step_s * 1e6)
         step_wall = vehicle.step_s / self.clock.speedup
-        return round((self._origin_unix + vehicle.steps * step_wall) * 1e6)
+        return round((self._origin_unix + steps * step_wall) * 1e6)
+
+    def _others_last_step(self) -> dict[str, tuple[Any, Any]] | None:
+        """Each other vehicle's true motion over the step just ended (for contact), from the
+        truth channel: in lockstep every vehicle's truth of that step is in before the tick
+        that starts this one (it left before the vehicle's step marker)."""
+        receiver, vehicle = self.truth_receiver, self.vehicle
+        assert vehicle is not None
+        if receiver is None or vehicle.steps == 0:
+            return None
+        receiver.drain()
+        motions = receiver.motions(self._physical_usec(1), self._physical_usec())
+        return {VehicleIdentity.from_system_id(s).name: m for s, m in motions.items()}
 
     def _truth_wait_wall_s(self) -> float:
         """How long a support waits for the work UAV's truth of its step."""
@@ -274,11 +289,11 @@ class VehicleServer:
         """One step; False if its publication waits for the work UAV's truth."""
         vehicle = self.vehicle
         assert vehicle is not None
-        vehicle.step()
+        vehicle.step(self._others_last_step())
         physical_usec = self._physical_usec()
         if self.truth_sender is not None:
             self.truth_sender.publish(vehicle.kinematics.truth, physical_usec)
-        if self.truth_receiver is None or not vehicle.sensor_due():
+        if self.truth_receiver is None or vehicle.identity.is_work or not vehicle.sensor_due():
             self._publish_step(None)
             return True
         self.truth_receiver.drain()

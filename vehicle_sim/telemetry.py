@@ -26,8 +26,11 @@ def _u16(value: float) -> int:
     return int(min(max(round(value), 0), UINT16_UNKNOWN - 1))
 
 
-def heartbeat(mode: int, armed: bool, failsafe: bool) -> mavlink2.MAVLink_heartbeat_message:
-    """A quadrotor's HEARTBEAT with ArduPilot's mode numbers, armed state and health."""
+def heartbeat(
+    mode: int, armed: bool, failsafe: bool, crashed: bool = False
+) -> mavlink2.MAVLink_heartbeat_message:
+    """A quadrotor's HEARTBEAT with ArduPilot's mode numbers, armed state and health (a crashed
+    vehicle reports MAV_STATE_EMERGENCY)."""
     base = mavlink2.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED | mavlink2.MAV_MODE_FLAG_STABILIZE_ENABLED
     if mode in (modes.GUIDED, modes.AUTO):
         base |= mavlink2.MAV_MODE_FLAG_GUIDED_ENABLED
@@ -38,6 +41,8 @@ def heartbeat(mode: int, armed: bool, failsafe: bool) -> mavlink2.MAVLink_heartb
     state = mavlink2.MAV_STATE_ACTIVE if armed else mavlink2.MAV_STATE_STANDBY
     if failsafe:
         state = mavlink2.MAV_STATE_CRITICAL
+    if crashed:
+        state = mavlink2.MAV_STATE_EMERGENCY
     return mavlink2.MAVLink_heartbeat_message(
         mavlink2.MAV_TYPE_QUADROTOR, mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA, base, mode, state, 3
     )

@@ -1,9 +1,10 @@
-"""The simulation-only truth channel: the work UAV's true position, for the supports' cameras.
+"""The simulation-only truth channel: every vehicle's true position, for the supports' cameras
+and for contact between vehicles.
 
-A real camera sees the real work UAV; a simulated one must be told where it truly is. After
-every step the work vehicle sends ATT_POS_MOCAP (a motion-capture fix: the truth) of its true
-position over separate UDP sockets to each support vehicle's truth port. The ground station
-never listens on these ports, so truth cannot leak into estimation.
+A real camera sees the real work UAV, and real vehicles touch; simulated ones must be told where
+the others truly are. After every step each vehicle sends ATT_POS_MOCAP (a motion-capture fix:
+the truth) of its true position over separate UDP sockets to every other vehicle's truth port.
+The ground station never listens on these ports, so truth cannot leak into estimation.
 
 Each sample carries the physical time of the step it ends (``time_usec``): the simulated time
 in lockstep, where every vehicle shares the ground station's clock; the host's wall clock
@@ -36,14 +37,14 @@ def truth_message(truth_enu: np.ndarray, time_usec: int) -> mavlink2.MAVLink_att
 
 
 class TruthSender:
-    """Work side: publish the true position after each step."""
+    """Publish this vehicle's true position after each step to the other vehicles."""
 
     def __init__(self, system_id: int, destinations: list[Address]) -> None:
         self.destinations = list(destinations)
         self.endpoint = UdpEndpoint(MavlinkCodec(system_id, 1))
 
     def publish(self, truth_enu: np.ndarray, time_usec: int) -> None:
-        """Send the truth at physical time ``time_usec`` to every support."""
+        """Send the truth at physical time ``time_usec`` to every other vehicle."""
         if self.destinations:
             self.endpoint.send(truth_message(truth_enu, time_usec), self.destinations)
 
@@ -53,19 +54,25 @@ class TruthSender:
 
 
 class TruthReceiver:
-    """Support side: keep the work UAV's recent true positions by physical time.
+    """Keep the other vehicles' recent true positions by physical time, per system id (the
+    work UAV is system 1).
 
-    A support waits (briefly) for the truth of its sample only while it may still come: once
-    it has heard from a work vehicle at all, and while nothing at or after that time has
-    arrived (the samples come in order). A support running alone publishes not-valid
-    observations.
+    A support waits (briefly) for the work UAV's truth of its camera sample only while it may
+    still come: once it has heard from a work vehicle at all, and while nothing at or after
+    that time has arrived (the samples come in order). A support running alone publishes
+    not-valid observations.
     """
 
     def __init__(
-        self, port: int, host: str = "127.0.0.1", sock: socket.socket | None = None
+        self,
+        port: int,
+        host: str = "127.0.0.1",
+        sock: socket.socket | None = None,
+        own_system: int = 0,
     ) -> None:
         self.endpoint = UdpEndpoint(MavlinkCodec(0, 0), (host, port), sock=sock)
-        self.samples: OrderedDict[int, np.ndarray] = OrderedDict()
+        self.own_system = own_system
+        self.by_system: dict[int, OrderedDict[int, np.ndarray]] = {}
         self.extrapolated = 0  # samples looked up beyond the newest truth
         self.interpolated = 0  # samples looked up between two truths
 
@@ -76,16 +83,35 @@ class TruthReceiver:
     def drain(self) -> None:
         """Read every pending truth sample."""
         for message, _ in self.endpoint.receive():
-            if message.get_type() != "ATT_POS_MOCAP" or message.get_srcSystem() != 1:
+            system = message.get_srcSystem()
+            if message.get_type() != "ATT_POS_MOCAP" or system == self.own_system:
                 continue
             position = ned_to_enu(np.array([message.x, message.y, message.z], dtype=float))
             if not np.all(np.isfinite(position)):
                 continue
             time_usec = int(message.time_usec)
-            self.samples[time_usec] = position
-            self.samples.move_to_end(time_usec)
-            while len(self.samples) > KEEP_SAMPLES:
-                self.samples.popitem(last=False)
+            samples = self.by_system.setdefault(system, OrderedDict())
+            samples[time_usec] = position
+            samples.move_to_end(time_usec)
+            while len(samples) > KEEP_SAMPLES:
+                samples.popitem(last=False)
+
+    @property
+    def samples(self) -> OrderedDict[int, np.ndarray]:
+        """The work UAV's samples (the camera's)."""
+        return self.by_system.get(1, OrderedDict())
+
+    def motions(self, start_usec: int, end_usec: int) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """Each other vehicle's true positions at the start and the end of a step, for those
+        heard from at or after its start (exact, else interpolated or extrapolated)."""
+        found = {}
+        for system, samples in self.by_system.items():
+            if samples and next(reversed(samples)) >= start_usec:
+                start = self._estimate(samples, start_usec, count=False)
+                end = self._estimate(samples, end_usec, count=False)
+                if start is not None and end is not None:
+                    found[system] = (start, end)
+        return found
 
     def may_still_come(self, time_usec: int) -> bool:
         """Whether the truth at this time is worth waiting for: some truth has arrived, none
@@ -100,23 +126,28 @@ class TruthReceiver:
         """Truth at this time: exact, else interpolated between the samples around it, else
         extrapolated from the two nearest (clipped: one interval past the newest,
         two before the oldest)."""
-        exact = self.exact(time_usec)
+        return self._estimate(self.samples, time_usec, count=True)
+
+    def _estimate(
+        self, samples: OrderedDict[int, np.ndarray], time_usec: int, count: bool
+    ) -> np.ndarray | None:
+        exact = samples.get(time_usec)
         if exact is not None:
             return exact
-        if not self.samples:
+        if not samples:
             return None
-        times = sorted(self.samples)
+        times = sorted(samples)
         if len(times) == 1:
-            self.extrapolated += 1
-            return self.samples[times[0]]
+            self.extrapolated += count
+            return samples[times[0]]
         after = int(np.searchsorted(times, time_usec))
         if 0 < after < len(times):
-            self.interpolated += 1
+            self.interpolated += count
             t0, t1 = times[after - 1], times[after]
         else:
-            self.extrapolated += 1
+            self.extrapolated += count
             t0, t1 = (times[0], times[1]) if after == 0 else (times[-2], times[-1])
-        p0, p1 = self.samples[t0], self.samples[t1]
+        p0, p1 = samples[t0], samples[t1]
         fraction = (time_usec - t0) / (t1 - t0)
         return p0 + (p1 - p0) * float(np.clip(fraction, -2.0, 2.0))
 

@@ -20,8 +20,10 @@ from mission.link.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
-from vehicle_sim import modes, telemetry
+from mission.world.proximity import StructureProximity
+from vehicle_sim import modes, streams, telemetry
 from vehicle_sim.commands import execute, set_mode
+from vehicle_sim.contact import Contact, ContactDetector, ContactWatch, as_sent
 from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
@@ -67,6 +69,9 @@ class Vehicle:
         self.rng_camera = np.random.default_rng(camera_seed)
         self.rng_motion = np.random.default_rng(motion_seed)
         self.kinematics = Kinematics.at(self.home)
+        detector = ContactDetector(StructureProximity(world.structure), scenario.vehicle.radius_m)
+        self.watch = ContactWatch(detector, scenario.run.stop_on_crash)
+        self._last_move = (as_sent(self.home), as_sent(self.home))  # the last step, as sent
         self.armed = False
         self.mode = modes.LOITER
         self.sim_time_s = 0.0
@@ -109,7 +114,12 @@ class Vehicle:
 
     def heartbeat(self) -> Any:
         """The HEARTBEAT describing armed state and mode."""
-        return telemetry.heartbeat(self.mode, self.armed, self.failsafe)
+        return telemetry.heartbeat(self.mode, self.armed, self.failsafe, self.crashed)
+
+    @property
+    def crashed(self) -> bool:
+        """True once a contact has crashed this vehicle (it stays where it touched)."""
+        return self.watch.crash is not None
 
     @property
     def time_boot_ms(self) -> int:
@@ -143,39 +153,7 @@ class Vehicle:
 
     def build_stream(self, message_id: int, work_truth: np.ndarray | None = None) -> Any:
         """Build one message of a stream for the current state (samples sensors when needed)."""
-        k = self.kinematics
-        if message_id == mavlink2.MAVLINK_MSG_ID_SIM_STATE:
-            return telemetry.sim_state(k.truth, k.velocity, self.frame)
-        if message_id == mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED:
-            return telemetry.local_position_ned(k.believed, k.velocity, self.time_boot_ms)
-        if message_id == mavlink2.MAVLINK_MSG_ID_GLOBAL_POSITION_INT:
-            return telemetry.global_position_int(
-                k.believed, k.velocity, np.zeros(3), self.frame, self.time_boot_ms
-            )
-        if message_id == mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT:
-            offset = self.world.zone_offset(k.truth[None])[0]
-            fix = self.world.gnss.sample_fix(k.truth, self.rng_gnss, offset)
-            return telemetry.gps_raw_int(
-                fix, self.frame, self.time_unix_usec, self.scenario.gnss.sigma_uere_m
-            )
-        if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
-            return telemetry.landing_target(self.observe(work_truth), self.time_unix_usec, 1)
-        if message_id == mavlink2.MAVLINK_MSG_ID_HEARTBEAT:
-            return self.heartbeat()
-        if message_id == mavlink2.MAVLINK_MSG_ID_SYS_STATUS:
-            return telemetry.sys_status(self.counters.bad_packets)
-        if message_id == mavlink2.MAVLINK_MSG_ID_MISSION_CURRENT:
-            state = (
-                mavlink2.MISSION_STATE_NO_MISSION
-                if not self.mission.items
-                else mavlink2.MISSION_STATE_ACTIVE
-            )
-            return mavlink2.MAVLink_mission_current_message(
-                self.mission.current, len(self.mission.items), state, 0
-            )
-        if message_id == mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
-            return telemetry.autopilot_version(self.identity.system_id)
-        raise KeyError(message_id)
+        return streams.build(self, message_id, work_truth)
 
     def observe(self, work_truth: np.ndarray | None):
         """The camera's observation of the work UAV (not valid without its truth)."""
@@ -186,11 +164,21 @@ class Vehicle:
         return self.world.camera.observe(self.kinematics.truth, work_truth, self.rng_camera)
 
     # -- stepping ---------------------------------------------------------------------------
-    def step(self) -> None:
-        """Advance one step of simulated time: failsafe check, mode logic, motion."""
+    def step(self, others: dict[str, tuple[np.ndarray, np.ndarray]] | None = None) -> None:
+        """Advance one step of simulated time: contacts with other vehicles over the step just
+        ended (``others``: each one's true position at its start and end, as the truth channel
+        carries them), failsafe check, mode logic, motion, contacts with the structure and
+        the ground along the move."""
+        if others:
+            start_s = self.sim_time_s - self.step_s
+            found = self.watch.detector.with_vehicles(
+                self._last_move, others, start_s, self.sim_time_s
+            )
+            self._report(self.watch.new_contacts("vehicles", found))
         self._check_failsafe()
         if self.armed and self.mode == modes.AUTO:
             self._fly_mission()
+        start, start_s = self.kinematics.truth.copy(), self.sim_time_s
         if self.armed:
             self.kinematics.step(
                 self.step_s,
@@ -200,6 +188,23 @@ class Vehicle:
             )
         self.steps += 1
         self.sim_time_s = self.steps * self.step_s
+        if self.armed:
+            found = self.watch.detector.with_surroundings(
+                start, self.kinematics.truth, start_s, self.sim_time_s
+            )
+            self._report(self.watch.new_contacts("surroundings", found))
+        self._last_move = (as_sent(start), as_sent(self.kinematics.truth))
+
+    def _report(self, contacts: list[Contact]) -> None:
+        """Say what was touched; a crash stops the vehicle where it touched and disarms it."""
+        for contact in contacts:
+            crash = contact is self.watch.crash
+            severity = mavlink2.MAV_SEVERITY_EMERGENCY if crash else mavlink2.MAV_SEVERITY_CRITICAL
+            self.notify(severity, contact.text(crash))
+            if crash:
+                self.kinematics.stop_at(contact.position_m)
+                self.armed = False
+                self.failsafe = False
 
     def join_clock(self, time_s: float) -> None:
         """Take up a running clock before the first step: the next step ends at ``time_s``."""
@@ -267,6 +272,9 @@ class Vehicle:
             handler(self, msg)
 
     def _on_setpoint(self, msg: Any) -> None:
+        if self.crashed:
+            self.counters.reject("setpoint: crashed")
+            return
         problem = setpoint_problem(msg, self.armed and self.mode == modes.GUIDED)
         target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
         if problem is None:

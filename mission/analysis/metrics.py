@@ -26,6 +26,7 @@ import numpy as np
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.analysis.safety import safety_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate, truth_time
 from mission.config.settings import Scenario
 from mission.world.frames import GeodeticFrame, ned_to_enu
@@ -33,6 +34,7 @@ from mission.world.model import World
 
 GCS_SYSTEM_ID = 255
 _LINK_EVENT = re.compile(r"^support-\d+ (lost|back)")
+_CONTACT = re.compile(r"^(Crash|Contact): (\S+) t=(-?[\d.]+) at (-?[\d.]+),(-?[\d.]+),(-?[\d.]+)")
 _WANTED_IDS = frozenset(
     {
         mavlink2.MAVLINK_MSG_ID_SIM_STATE,
@@ -54,6 +56,8 @@ class RunTrace:
     ticks: set[float] = field(default_factory=set)
     completion: float | None = None
     link_events: list[dict[str, Any]] = field(default_factory=list)
+    contacts: list[dict[str, Any]] = field(default_factory=list)  # as the vehicles reported them
+    stopped: str | None = None  # the ground station's word that it stopped the run
     max_gap_s: float = 1.0  # truth is interpolated between samples at most this far apart
 
     @property
@@ -120,6 +124,10 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
             if source in pending_truth:
                 stamped.append((source, int(message.time_unix_usec), pending_truth.pop(source)))
+        elif kind == "STATUSTEXT" and source != GCS_SYSTEM_ID:
+            contact = _CONTACT.match(message.text)
+            if contact:
+                trace.contacts.append(_contact_event(source, contact))
         elif kind == "TIMESYNC" and source != GCS_SYSTEM_ID:
             received_ns = round(message._timestamp * 1e9 - epoch * 1e9)
             replies.append(TimesyncReply(source, message.tc1, message.ts1, received_ns))
@@ -135,6 +143,8 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
         elif kind == "STATUSTEXT" and "Mission complete" in message.text:
             trace.completion = t if trace.completion is None else trace.completion
+        elif kind == "STATUSTEXT" and message.text.startswith("Run stopped: "):
+            trace.stopped = trace.stopped or f"{message.text[13:]} at {t:.1f} s"
         elif kind == "STATUSTEXT" and _LINK_EVENT.match(message.text):
             trace.link_events.append({"t": t, "event": message.text})
     offsets = {} if trace.ticks else clock_offsets(replies)
@@ -145,6 +155,20 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
                 position
             )
     return trace
+
+
+def _contact_event(system: int, match: re.Match) -> dict[str, Any]:
+    """A vehicle's contact report as summary.json holds it (its clock's time: in lockstep,
+    the ground station's)."""
+    vehicle = "work" if system == 1 else f"support-{system - 1}"
+    kind, other, time_s, *where = match.groups()
+    return {
+        "t": float(time_s),
+        "vehicle": vehicle,
+        "with": other,
+        "at_m": [float(v) for v in where],
+        "crash": kind == "Crash",
+    }
 
 
 def _tlog_messages(tlog: Path) -> Iterator[Any]:
@@ -235,11 +259,13 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
     return {
         "completed": trace.completion is not None,
         "completion_time_s": trace.completion,
+        "stopped": trace.stopped,
         "control_cycles": len(trace.estimates),
         "multipath_steps": counts,
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": _stats([float(e) for e in errors]),
         "link_events": trace.link_events,
+        "safety": safety_metrics(trace, world),
     }
 
 

@@ -257,10 +257,11 @@ class ControlSettings:
     escape_starts: bool  # where G has risen, also start the support MPC from escaping paths
     min_separation_m: float  # between any two UAVs over the MPCs' horizon (0: no margin)
     clearance_m: float  # from the structure and the ground over the horizon (0: no margin)
+    estimate_allowance_m: float  # the MPCs keep margins this much wider per estimate involved
 
     def __post_init__(self) -> None:
         _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
-        _non_negative(self, "min_separation_m", "clearance_m")
+        _non_negative(self, "min_separation_m", "clearance_m", "estimate_allowance_m")
         _positive(self, "t_pred_s", "t_cont_s", "s_max_work_m_s", "s_max_support_m_s")
         _positive(self, "arrival_tol_m", "support_max_sigma0_m")
         _non_negative(self, "w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")

@@ -19,10 +19,13 @@ def check_plan_files(world: KnownWorld, directory: Path, names: Sequence[str]) -
     """Each vehicle's ``<name>.waypoints`` in ``directory``: home and at least one waypoint,
     no more items than a vehicle stores, every row a navigation command in a global frame,
     every position inside the workspace and outside the structure; every support with as many
-    waypoints as the work UAV (they pair by index). The first problem raises InputError naming
-    the file and the item."""
+    waypoints as the work UAV (they pair by index), and the margins kept: every waypoint at
+    least ``control.clearance_m`` from the structure and the ground, every two vehicles'
+    waypoints of the same index at least ``control.min_separation_m`` apart. The first problem
+    raises InputError naming the file and the item."""
     frame = GeodeticFrame(world.scenario.world.anchor)
     counts = {}
+    positions: dict[str, np.ndarray] = {}
     for name in names:
         path = Path(directory) / f"{name}.waypoints"
         if not path.is_file():
@@ -37,12 +40,46 @@ def check_plan_files(world: KnownWorld, directory: Path, names: Sequence[str]) -
         for row in rows:
             _check_row(world, frame, path, row)
         counts[name] = len(rows) - 1
+        positions[name] = np.array([row_position_enu(row, frame) for row in rows[1:]])
     work = counts.get("work")
     for name, count in counts.items():
         if work is not None and count != work:
             path = Path(directory) / f"{name}.waypoints"
             problem = f"{count} waypoints, but work.waypoints has {work} (they pair by index)"
             raise InputError(str(path), "", problem)
+    _check_margins(world, Path(directory), positions)
+
+
+def _check_margins(world: KnownWorld, directory: Path, positions: dict[str, np.ndarray]) -> None:
+    """The planned paths keep the margins the MPCs will hold the vehicles to."""
+    from mission.world.proximity import StructureProximity
+
+    control = world.scenario.control
+    if control.clearance_m > 0:
+        proximity = StructureProximity(world.structure)
+        for name, points in positions.items():
+            gaps = proximity.clearance(points)
+            worst = int(np.argmin(gaps))
+            if gaps[worst] < control.clearance_m - 1e-6:
+                problem = (
+                    f"{gaps[worst]:.2f} m from the structure or the ground, less than "
+                    f"control.clearance_m ({control.clearance_m:g} m)"
+                )
+                raise InputError(str(directory / f"{name}.waypoints"), f"item {worst + 1}", problem)
+    if control.min_separation_m > 0:
+        names = list(positions)
+        for i, first in enumerate(names):
+            for second in names[i + 1 :]:
+                count = min(len(positions[first]), len(positions[second]))
+                gaps = np.linalg.norm(positions[first][:count] - positions[second][:count], axis=1)
+                worst = int(np.argmin(gaps))
+                if gaps[worst] < control.min_separation_m - 1e-6:
+                    problem = (
+                        f"{gaps[worst]:.2f} m from {second}'s waypoint of the same index, less "
+                        f"than control.min_separation_m ({control.min_separation_m:g} m)"
+                    )
+                    path = str(directory / f"{first}.waypoints")
+                    raise InputError(path, f"item {worst + 1}", problem)
 
 
 def _check_row(world: KnownWorld, frame: GeodeticFrame, path: Path, row: WaypointRow) -> None:

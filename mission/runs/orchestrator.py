@@ -131,8 +131,7 @@ def _start_processes(options: RunOptions, scenario: Scenario, children: list[Chi
     # Every socket is bound here and inherited, so the ground station starts first knowing
     # every address, before any vehicle has printed its banner.
     sockets = {name: _bound_udp() for name in names}
-    truth_sockets = {name: _bound_udp() for name in names[1:]}
-    truth_out = [a for t in truth_sockets.values() for a in ("--truth-out", _address_of(t))]
+    truth_sockets = {name: _bound_udp() for name in names}  # each vehicle's, for the others
     addresses = ",".join(f"{n}={_address_of(sockets[n])}" for n in names)
     helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
     forking = options.process_start == "fork" and fork_is_safe()
@@ -143,13 +142,12 @@ def _start_processes(options: RunOptions, scenario: Scenario, children: list[Chi
     children.append(gcs)
     vehicle_main = _vehicle_main() if forking else None
     for name in names:
-        fds = [sockets[name].fileno()]
+        fds = [sockets[name].fileno(), truth_sockets[name].fileno()]
         arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
-        if name in truth_sockets:
-            fds.append(truth_sockets[name].fileno())
-            arguments += ["--truth-socket-fd", str(fds[1])]
-        else:
-            arguments += truth_out
+        arguments += ["--truth-socket-fd", str(fds[1])]
+        for other in names:
+            if other != name:
+                arguments += ["--truth-out", _address_of(truth_sockets[other])]
         arguments += [*observer, *common]
         children.append(_launch(options.out_dir, name, arguments, fds, vehicle_main))
     for sock in (*sockets.values(), *truth_sockets.values()):

@@ -52,6 +52,11 @@ class Structure:
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
 
     @property
+    def solid_file_mesh(self) -> trimesh.Trimesh | None:
+        """The mesh file's mesh where it is watertight (it has an inside), else None."""
+        return self._solid_file_mesh
+
+    @property
     def uses_embree(self) -> bool:
         """True when ray queries go through Embree."""
         return self.rays.name == "Embree"

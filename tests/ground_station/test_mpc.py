@@ -207,8 +207,9 @@ def test_the_far_branch_is_solved_where_it_wins(setting):
     blocked[-1] = 1.0
     corner, window = mpc.window_of(yhat, world.sigma0_map().sigma_m)
     fixed = np.concatenate([yhat, targets.ravel(), terminal, work.ravel()])
-    flags = np.concatenate([anchors.ravel(), blocked, corner, window])
     guess = np.linspace(yhat, terminal, horizon + 1)[1:]
+    margins = mpc.margins.parameters(guess, yhat, np.zeros((0, horizon, 3)))
+    flags = np.concatenate([anchors.ravel(), blocked, corner, window, margins])
     path, status, cost = mpc._solve_once(fixed, flags, guess)
     near = mpc._solve_branch(fixed, flags, guess, "near")
     assert status == CONVERGED
@@ -315,8 +316,10 @@ def test_supports_stay_out_of_the_structures_gnss_shadow(along_world):
     limit = along_world.scenario.control.support_max_sigma0_m
     kept_out, _ = _blocked_case(along_world, _with_control(along_world, los_penalty="paper"))
     assert np.all(hermite_zero_slope(sigma0, grid, kept_out.path) <= limit + 1e-3)
+    unsafe = {"min_separation_m": 0.0, "clearance_m": 0.0}  # the margins would keep it out too
     free, _ = _blocked_case(
-        along_world, _with_control(along_world, los_penalty="paper", support_max_sigma0_m=1e9)
+        along_world,
+        _with_control(along_world, los_penalty="paper", support_max_sigma0_m=1e9, **unsafe),
     )
     assert np.max(hermite_zero_slope(sigma0, grid, free.path)) > limit  # into the deck
 

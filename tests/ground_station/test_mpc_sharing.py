@@ -119,7 +119,8 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
         ours = local.mpc.plan(request, local.observable)
         theirs = interpreted.plan(request, local.observable)
         assert (ours.status, theirs.status) == (CONVERGED, CONVERGED)
-        np.testing.assert_allclose(theirs.path, ours.path, atol=1e-3 if solver == "ipopt" else 1e-6)
+        # the two solvers stop at tolerance 1e-4: ~1 mm apart where a margin is active
+        np.testing.assert_allclose(theirs.path, ours.path, atol=2e-3 if solver == "ipopt" else 1e-6)
 
 
 @pytest.mark.slow

@@ -1,0 +1,160 @@
+"""How far points are from the structure and the ground, and the half-spaces that keep a point
+clear of them: what contact detection (the vehicles) and the MPCs' margins (the ground station)
+share.
+
+The structure is a set of convex pieces: each box primitive (distances in closed form, signed:
+negative inside), and a mesh file as one more piece (trimesh's closest points, unsigned; a
+watertight file's inside counts as negative). The ground is the plane z = 0.
+
+A *separating half-space* of a point g from a convex piece is {x : n.x >= n.c}, c the piece's
+point closest to g and n the unit vector from c to g (inside a box, the normal of the face it is
+nearest to). The piece lies wholly on the other side, so any x with n.x >= n.c + m is at least
+m from the piece: a linear constraint that is conservative, never optimistic (for a mesh file,
+which need not be convex, it holds near c only).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.world.structure import Structure
+
+BOX_FACES = 12  # triangles a box primitive adds to the structure's mesh
+
+
+@dataclass(frozen=True)
+class HalfSpaces:
+    """Per point, ``slots`` half-spaces n.x >= b (rows of unit ``normals`` and ``offsets``); an
+    unused slot is n = 0, b = -1 (always true)."""
+
+    normals: np.ndarray  # (points, slots, 3)
+    offsets: np.ndarray  # (points, slots)
+
+
+class StructureProximity:
+    """Distances from points to the structure's convex pieces, and separating half-spaces."""
+
+    def __init__(self, structure: Structure) -> None:
+        boxes = structure.boxes
+        self.low = np.array([b.min_m for b in boxes], dtype=float).reshape(-1, 3)
+        self.high = np.array([b.max_m for b in boxes], dtype=float).reshape(-1, 3)
+        extra = structure.faces[BOX_FACES * len(boxes) :]
+        self._file_mesh = None
+        if len(extra):
+            import trimesh  # a mesh file's world imports it anyway
+
+            used = np.unique(extra)
+            remap = np.full(len(structure.vertices), -1)
+            remap[used] = np.arange(len(used))
+            self._file_mesh = trimesh.Trimesh(structure.vertices[used], remap[extra], process=False)
+            self._file_solid = structure.solid_file_mesh
+
+    @property
+    def pieces(self) -> int:
+        """How many convex pieces (boxes, and the mesh file as one)."""
+        return len(self.low) + (self._file_mesh is not None)
+
+    def closest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per point and piece: the signed distance (points, pieces), the closest point on the
+        piece (points, pieces, 3) and the outward unit normal there (points, pieces, 3)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        below = self.low[None] - points[:, None]  # > 0 where the point is below a box's side
+        above = points[:, None] - self.high[None]
+        outside = np.maximum(np.maximum(below, above), 0.0)
+        out_distance = np.linalg.norm(outside, axis=2)
+        depth = np.maximum(below, above)  # per axis: minus the distance to the nearer face
+        inside = out_distance == 0.0
+        nearest_face = np.max(depth, axis=2)  # minus the depth below the nearest face
+        distance = np.where(inside, nearest_face, out_distance)
+        closest = np.clip(points[:, None], self.low[None], self.high[None])
+        normals = np.divide(
+            points[:, None] - closest,
+            out_distance[..., None],
+            out=np.zeros_like(closest),
+            where=out_distance[..., None] > 0,
+        )
+        if inside.any():  # inside: out through the nearest face
+            axis = np.argmax(depth, axis=2)
+            sign = np.where(
+                np.take_along_axis(above, axis[..., None], 2)[..., 0]
+                >= np.take_along_axis(below, axis[..., None], 2)[..., 0],
+                1.0,
+                -1.0,
+            )
+            face_normals = np.eye(3)[axis] * sign[..., None]
+            high = np.take_along_axis(np.broadcast_to(self.high, depth.shape), axis[..., None], 2)
+            low = np.take_along_axis(np.broadcast_to(self.low, depth.shape), axis[..., None], 2)
+            face = np.where(sign > 0, high[..., 0], low[..., 0])
+            projected = closest.copy()
+            np.put_along_axis(projected, axis[..., None], face[..., None], axis=2)
+            normals = np.where(inside[..., None], face_normals, normals)
+            closest = np.where(inside[..., None], projected, closest)
+        if self._file_mesh is not None:
+            on_mesh, gap, _ = self._file_mesh.nearest.on_surface(points)
+            direction = points - on_mesh
+            normal = np.divide(
+                direction, gap[:, None], out=np.zeros_like(direction), where=gap[:, None] > 0
+            )
+            if self._file_solid is not None:
+                within = self._file_solid.contains(points)
+                gap = np.where(within, -gap, gap)
+                normal = np.where(within[:, None], -normal, normal)
+            distance = np.column_stack([distance, gap])
+            closest = np.concatenate([closest, on_mesh[:, None]], axis=1)
+            normals = np.concatenate([normals, normal[:, None]], axis=1)
+        return distance, closest, normals
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Signed distance from each point to the structure (negative inside a box); +inf for
+        a world with no structure."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        if self.pieces == 0:
+            return np.full(len(points), np.inf)
+        return self.closest(points)[0].min(axis=1)
+
+    def clearance(self, points: np.ndarray) -> np.ndarray:
+        """Distance from each point to whatever is nearer, the structure or the ground."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        return np.minimum(self.distance(points), points[:, 2])
+
+    def half_spaces(self, points: np.ndarray, slots: int, margin_m: float, reach_m: float):
+        """For each point, separating half-spaces from its ``slots`` nearest pieces within
+        ``reach_m``, each moved out by ``margin_m`` (n.x >= n.c + margin)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        normals = np.zeros((len(points), slots, 3))
+        offsets = np.full((len(points), slots), -1.0)
+        if self.pieces == 0 or slots == 0:
+            return HalfSpaces(normals, offsets)
+        distance, closest, normal = self.closest(points)
+        order = np.argsort(distance, axis=1, kind="stable")[:, :slots]
+        for row in range(len(points)):
+            for slot, piece in enumerate(order[row]):
+                if distance[row, piece] <= reach_m:
+                    n = normal[row, piece]
+                    normals[row, slot] = n
+                    offsets[row, slot] = float(n @ closest[row, piece]) + margin_m
+        return HalfSpaces(normals, offsets)
+
+
+def segment_points(start: np.ndarray, end: np.ndarray, spacing_m: float) -> np.ndarray:
+    """Points from ``start`` to ``end`` (both included) at most ``spacing_m`` apart."""
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    count = int(np.ceil(np.linalg.norm(end - start) / spacing_m)) + 1
+    fractions = np.linspace(0.0, 1.0, max(count, 2))
+    return start + (end - start) * fractions[:, None]
+
+
+def closest_approach(
+    a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray
+) -> tuple[float, float]:
+    """Two points moving straight from a0 to a1 and from b0 to b1 over the same interval:
+    (their least distance, the fraction of the interval when it happens). Symmetric in a and
+    b bit for bit (the relative motion is negated exactly)."""
+    d0 = np.asarray(a0, dtype=float) - np.asarray(b0, dtype=float)
+    d1 = np.asarray(a1, dtype=float) - np.asarray(b1, dtype=float)
+    change = d1 - d0
+    speed_sq = float(change @ change)
+    fraction = 0.0 if speed_sq == 0 else float(np.clip(-(d0 @ change) / speed_sq, 0.0, 1.0))
+    return float(np.linalg.norm(d0 + fraction * change)), fraction

@@ -1,0 +1,111 @@
+"""Contact detection: a vehicle's true body (a sphere of ``vehicle.radius_m``) touching the
+structure, the ground or another vehicle's body.
+
+Each step's motion is a straight segment. Against the structure and the ground it is sampled
+every quarter radius (a body cannot pass through a deck between samples); against another
+vehicle the two straight motions over the same interval give their exact closest approach
+(:func:`~mission.world.proximity.closest_approach`). A contact is a distance below the radius
+(below two radii between bodies): a near miss just outside is none.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.world.frames import enu_to_ned, ned_to_enu
+from mission.world.proximity import StructureProximity, closest_approach, segment_points
+
+STRUCTURE = "structure"
+GROUND = "ground"
+
+
+@dataclass(frozen=True)
+class Contact:
+    """What a vehicle touched (``structure``, ``ground`` or another vehicle's name), when
+    (simulated seconds), where (its own true position then, ENU) and the distance found
+    (centre to surface; centre to centre between vehicles)."""
+
+    other: str
+    time_s: float
+    position_m: np.ndarray
+    distance_m: float
+
+    def text(self, crashed: bool) -> str:
+        """The STATUSTEXT (at most 50 characters): what, when and where."""
+        x, y, z = (float(v) for v in self.position_m)
+        head = "Crash" if crashed else "Contact"
+        return f"{head}: {self.other} t={self.time_s:.2f} at {x:.1f},{y:.1f},{z:.1f}"[:50]
+
+
+def as_sent(position: np.ndarray) -> np.ndarray:
+    """A position as the truth channel carries it (NED in float32, back in ENU): two vehicles
+    judge their closest approach from the same numbers."""
+    return ned_to_enu(np.asarray(enu_to_ned(position), dtype=np.float32).astype(float))
+
+
+class ContactDetector:
+    """One vehicle's contact checks, with its radius and the structure's proximity."""
+
+    def __init__(self, proximity: StructureProximity, radius_m: float) -> None:
+        self.proximity = proximity
+        self.radius_m = radius_m
+
+    def with_surroundings(
+        self, start: np.ndarray, end: np.ndarray, start_s: float, end_s: float
+    ) -> list[Contact]:
+        """The first contact with the structure and the first with the ground along a step from
+        ``start`` to ``end``."""
+        points = segment_points(start, end, self.radius_m / 4)
+        times = np.linspace(start_s, end_s, len(points))
+        found = []
+        for other, gaps in (
+            (STRUCTURE, self.proximity.distance(points)),
+            (GROUND, points[:, 2]),
+        ):
+            touching = np.flatnonzero(gaps < self.radius_m)
+            if len(touching):
+                i = int(touching[0])
+                found.append(Contact(other, float(times[i]), points[i], float(gaps[i])))
+        return found
+
+    def with_vehicles(
+        self,
+        own: tuple[np.ndarray, np.ndarray],
+        others: dict[str, tuple[np.ndarray, np.ndarray]],
+        start_s: float,
+        end_s: float,
+    ) -> list[Contact]:
+        """Contacts with other vehicles over a step: ``own`` and each of ``others`` are
+        (position at start, position at end) as the truth channel carries them."""
+        found = []
+        for name, (start, end) in sorted(others.items()):
+            distance, fraction = closest_approach(own[0], own[1], start, end)
+            if distance < 2 * self.radius_m:
+                where = own[0] + fraction * (own[1] - own[0])
+                when = start_s + fraction * (end_s - start_s)
+                found.append(Contact(name, when, where, distance))
+        return found
+
+
+class ContactWatch:
+    """A vehicle's contacts over a run: each new contact (one per episode of touching the same
+    thing) is kept, and the first one is a crash when the run stops on crashes."""
+
+    def __init__(self, detector: ContactDetector, stop_on_crash: bool) -> None:
+        self.detector = detector
+        self.stop_on_crash = stop_on_crash
+        self.contacts: list[Contact] = []
+        self.crash: Contact | None = None
+        self._touching: dict[str, set[str]] = {"vehicles": set(), "surroundings": set()}
+
+    def new_contacts(self, kind: str, found: list[Contact]) -> list[Contact]:
+        """The contacts of ``found`` (a check of ``kind``: vehicles or surroundings) that
+        begin an episode; the first of them becomes the crash if there is to be one."""
+        fresh = [c for c in found if c.other not in self._touching[kind]]
+        self._touching[kind] = {c.other for c in found}
+        self.contacts += fresh
+        if fresh and self.stop_on_crash and self.crash is None:
+            self.crash = fresh[0]
+        return fresh

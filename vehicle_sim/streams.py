@@ -1,0 +1,49 @@
+"""One message of a vehicle's streams, built for its current state (sensors sampled when the
+message carries a measurement)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from vehicle_sim import telemetry
+
+
+def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -> Any:
+    """Build one message of a stream for the current state of ``vehicle`` (a
+    :class:`~vehicle_sim.vehicle.Vehicle`, which calls this)."""
+    k = vehicle.kinematics
+    if message_id == mavlink2.MAVLINK_MSG_ID_SIM_STATE:
+        return telemetry.sim_state(k.truth, k.velocity, vehicle.frame)
+    if message_id == mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED:
+        return telemetry.local_position_ned(k.believed, k.velocity, vehicle.time_boot_ms)
+    if message_id == mavlink2.MAVLINK_MSG_ID_GLOBAL_POSITION_INT:
+        return telemetry.global_position_int(
+            k.believed, k.velocity, np.zeros(3), vehicle.frame, vehicle.time_boot_ms
+        )
+    if message_id == mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT:
+        offset = vehicle.world.zone_offset(k.truth[None])[0]
+        fix = vehicle.world.gnss.sample_fix(k.truth, vehicle.rng_gnss, offset)
+        return telemetry.gps_raw_int(
+            fix, vehicle.frame, vehicle.time_unix_usec, vehicle.scenario.gnss.sigma_uere_m
+        )
+    if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
+        return telemetry.landing_target(vehicle.observe(work_truth), vehicle.time_unix_usec, 1)
+    if message_id == mavlink2.MAVLINK_MSG_ID_HEARTBEAT:
+        return vehicle.heartbeat()
+    if message_id == mavlink2.MAVLINK_MSG_ID_SYS_STATUS:
+        return telemetry.sys_status(vehicle.counters.bad_packets)
+    if message_id == mavlink2.MAVLINK_MSG_ID_MISSION_CURRENT:
+        state = (
+            mavlink2.MISSION_STATE_NO_MISSION
+            if not vehicle.mission.items
+            else mavlink2.MISSION_STATE_ACTIVE
+        )
+        return mavlink2.MAVLink_mission_current_message(
+            vehicle.mission.current, len(vehicle.mission.items), state, 0
+        )
+    if message_id == mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
+        return telemetry.autopilot_version(vehicle.identity.system_id)
+    raise KeyError(message_id)
