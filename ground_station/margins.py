@@ -25,7 +25,7 @@ from mission.world.proximity import StructureProximity
 from mission.world.structure import Structure
 
 STRUCTURE_SLOTS = 3  # the nearest structure pieces each step considers
-SLOTS = 3  # half-spaces a step keeps: the nearest to binding at the guess (fewer rows, faster)
+SLOTS = 3  # half-spaces a step keeps, the nearest to binding at the guess (fewer rows)
 UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -53,48 +53,57 @@ class Margins:
     def parameters(self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray) -> np.ndarray:
         """The NLP's margin parameters for a guess (U, 3): every step's normals (column by
         column of the (3, U slots) matrix), then their offsets. ``others`` (m, U, 3): the other
-        UAVs' predicted positions; missing ones leave their slots unused (n = 0, b = -1)."""
+        UAVs' predicted positions. Each step keeps the ``slots`` half-spaces nearest to
+        binding at the guess (least n.g - b); a slot left over is unused (n = 0, b = -1)."""
         if self.slots == 0:
             return np.zeros(0)
         horizon = len(guess)
-        normals = np.zeros((horizon, self.candidates, 3))
-        offsets = np.full((horizon, self.candidates), -1.0)
-        if self.other_slots:
-            for j, path in enumerate(np.asarray(others, dtype=float)[: self.other_slots]):
-                normals[:, j], offsets[:, j] = self._apart(guess, yhat, path)
+        normals, offsets = [], []
+        others = np.asarray(others, dtype=float)[: self.other_slots]
+        if len(others):
+            n, b = self._apart(guess, yhat, others)
+            normals.append(n)
+            offsets.append(b)
         if self.clearance > 0:
-            first = self.other_slots
-            spaces = self.proximity.half_spaces(
-                guess, self.structure_slots, self.clearance, self._reach_m
-            )
-            normals[:, first : first + self.structure_slots] = spaces.normals
-            offsets[:, first : first + self.structure_slots] = spaces.offsets
-            normals[:, -1], offsets[:, -1] = UP, self.clearance
-        # Each step keeps the half-spaces nearest to binding at the guess (least n.g - b;
-        # unused ones are never binding)
-        gap = np.where(
-            np.any(normals != 0, axis=2), np.einsum("usk,uk->us", normals, guess) - offsets, np.inf
-        )
-        keep = np.argsort(gap, axis=1, kind="stable")[:, : self.slots]
-        normals = np.take_along_axis(normals, keep[..., None], axis=1)
-        offsets = np.take_along_axis(offsets, keep, axis=1)
+            if self.structure_slots:
+                distance, closest, n = self.proximity.closest(guess)
+                far = distance > self._reach_m
+                n[far] = 0.0
+                b = np.einsum("usk,usk->us", n, closest) + self.clearance
+                b[far] = -1.0
+                normals.append(n)
+                offsets.append(b)
+            normals.append(np.broadcast_to(UP, (horizon, 1, 3)))
+            offsets.append(np.full((horizon, 1), self.clearance))
+        normals, offsets = np.concatenate(normals, axis=1), np.concatenate(offsets, axis=1)
+        if normals.shape[1] > self.slots:
+            gap = np.einsum("usk,uk->us", normals, guess) - offsets
+            keep = np.argsort(gap, axis=1, kind="stable")[:, : self.slots]
+            rows = np.arange(horizon)[:, None]
+            normals, offsets = normals[rows, keep], offsets[rows, keep]
+        elif normals.shape[1] < self.slots:
+            missing = self.slots - normals.shape[1]
+            normals = np.concatenate([normals, np.zeros((horizon, missing, 3))], axis=1)
+            offsets = np.concatenate([offsets, np.full((horizon, missing), -1.0)], axis=1)
         return np.concatenate([normals.reshape(-1), offsets.reshape(-1)])
 
     def _apart(
-        self, guess: np.ndarray, yhat: np.ndarray, other: np.ndarray
+        self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Per step, the half-space at ``separation`` beyond ``other`` facing the guess (from
-        yhat where the guess sits on it; straight up where both do)."""
-        away = guess - other
-        length = np.linalg.norm(away, axis=1)
+        """Per step (rows) and other UAV (columns), the half-space at ``separation`` beyond
+        the other's position facing the guess (from yhat where the guess sits on it;
+        straight up where both do)."""
+        other = others.transpose(1, 0, 2)  # (U, m, 3)
+        away = guess[:, None] - other
+        length = np.sqrt(np.einsum("usk,usk->us", away, away))
         flat = length < 1e-9
         if flat.any():
-            away[flat] = yhat - other[flat]
+            away[flat] = (yhat - other)[flat]
             length[flat] = np.linalg.norm(away[flat], axis=1)
             still = length < 1e-9
             away[still], length[still] = UP, 1.0
-        normals = away / length[:, None]
-        return normals, np.einsum("ij,ij->i", normals, other) + self.separation
+        normals = away / length[..., None]
+        return normals, np.einsum("usk,usk->us", normals, other) + self.separation
 
     def slack_guess(self, guess: np.ndarray, parameters: np.ndarray) -> np.ndarray:
         """Each step's largest violation at the guess (the slacks' starting point)."""

@@ -15,22 +15,11 @@ which need not be convex, it holds near c only).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from mission.world.structure import Structure
 
 BOX_FACES = 12  # triangles a box primitive adds to the structure's mesh
-
-
-@dataclass(frozen=True)
-class HalfSpaces:
-    """Per point, ``slots`` half-spaces n.x >= b (rows of unit ``normals`` and ``offsets``); an
-    unused slot is n = 0, b = -1 (always true)."""
-
-    normals: np.ndarray  # (points, slots, 3)
-    offsets: np.ndarray  # (points, slots)
 
 
 class StructureProximity:
@@ -118,24 +107,6 @@ class StructureProximity:
         """Distance from each point to whatever is nearer, the structure or the ground."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         return np.minimum(self.distance(points), points[:, 2])
-
-    def half_spaces(self, points: np.ndarray, slots: int, margin_m: float, reach_m: float):
-        """For each point, separating half-spaces from its ``slots`` nearest pieces within
-        ``reach_m``, each moved out by ``margin_m`` (n.x >= n.c + margin)."""
-        points = np.atleast_2d(np.asarray(points, dtype=float))
-        normals = np.zeros((len(points), slots, 3))
-        offsets = np.full((len(points), slots), -1.0)
-        if self.pieces == 0 or slots == 0:
-            return HalfSpaces(normals, offsets)
-        distance, closest, normal = self.closest(points)
-        order = np.argsort(distance, axis=1, kind="stable")[:, :slots]
-        for row in range(len(points)):
-            for slot, piece in enumerate(order[row]):
-                if distance[row, piece] <= reach_m:
-                    n = normal[row, piece]
-                    normals[row, slot] = n
-                    offsets[row, slot] = float(n @ closest[row, piece]) + margin_m
-        return HalfSpaces(normals, offsets)
 
 
 def segment_points(start: np.ndarray, end: np.ndarray, spacing_m: float) -> np.ndarray:
