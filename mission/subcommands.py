@@ -133,11 +133,17 @@ def realtime_speedup(args: argparse.Namespace) -> float | None:
 
 def run_line(summary: dict, timeout_s: float) -> str:
     """A finished run in one line of text."""
-    done = (
-        f"completed at {summary['completion_time_s']:.1f} s"
-        if summary["completed"]
-        else f"NOT completed within {timeout_s:g} s"
-    )
+    if summary["completed"]:
+        done = f"completed at {summary['completion_time_s']:.1f} s"
+    elif summary.get("stopped"):
+        done = f"STOPPED: {summary['stopped']}"
+    else:
+        done = f"NOT completed within {timeout_s:g} s"
+    safety = summary.get("safety") or {}
+    approaches = list((safety.get("closest_approach_m") or {}).values())
+    clearances = list((safety.get("least_clearance_m") or {}).values())
+    closest = f"; closest approach {min(approaches):.2f} m" if approaches else ""
+    clear = f", least clearance {min(clearances):.2f} m" if clearances else ""
     per_support = ", ".join(f"{name} {n}" for name, n in summary["multipath_steps"].items())
     mean = summary["work_error_m"]["mean"]
     error = "no estimate" if mean is None else f"mean {mean:.4f} m"
@@ -146,7 +152,7 @@ def run_line(summary: dict, timeout_s: float) -> str:
     return (
         f"{done}; {summary['control_cycles']} cycles; steps in multipath "
         f"{summary['multipath_steps_total']} ({per_support}); work UAV error {error}; "
-        f"wall {summary['wall_time_s']:.1f} s{speed}"
+        f"wall {summary['wall_time_s']:.1f} s{speed}{closest}{clear}"
     )
 
 

@@ -2,9 +2,9 @@
 
 - truth: SIM_STATE of each vehicle at its own time stamp, on the ground station's clock
   (:mod:`mission.analysis.truth`), interpolated between samples where needed;
-- the work UAV's estimate: the VISION_POSITION_ESTIMATE the ground station sent it at each
-  control cycle (each one is followed by the SET_POSITION_TARGET_LOCAL_NED for the same
-  vehicle, which names it); the cycles' times are the estimates';
+- the control cycles: one SET_POSITION_TARGET_LOCAL_NED to the work UAV each, at its time;
+- the work UAV's estimate: the VISION_POSITION_ESTIMATE the ground station sent it before a
+  cycle's setpoint (the setpoint names the vehicle); a blind cycle sends none;
 - the mode: lockstep where the ground station sent clock ticks (SYSTEM_TIME), else real time;
 - completion: the ground station's "Mission complete" STATUSTEXT.
 
@@ -53,6 +53,7 @@ class RunTrace:
 
     truth: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     estimates: dict[float, np.ndarray] = field(default_factory=dict)
+    cycles: set[float] = field(default_factory=set)  # times of the work UAV's setpoints
     ticks: set[float] = field(default_factory=set)
     completion: float | None = None
     link_events: list[dict[str, Any]] = field(default_factory=list)
@@ -72,8 +73,8 @@ class RunTrace:
 
     @property
     def cycle_times(self) -> list[float]:
-        """The control cycles' times (one estimate for the work UAV each)."""
-        return sorted(self.estimates)
+        """The control cycles' times (one setpoint for the work UAV each)."""
+        return sorted(self.cycles)
 
     def track(self, system: int) -> tuple[np.ndarray, np.ndarray]:
         """(times, positions) of one vehicle's truth."""
@@ -136,8 +137,10 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "VISION_POSITION_ESTIMATE":
             pending_estimate = (t, ned_to_enu(np.array([message.x, message.y, message.z])))
         elif kind == "SET_POSITION_TARGET_LOCAL_NED":
-            if pending_estimate is not None and message.target_system == 1:
-                trace.estimates[pending_estimate[0]] = pending_estimate[1]
+            if message.target_system == 1:
+                trace.cycles.add(t)
+                if pending_estimate is not None:
+                    trace.estimates[pending_estimate[0]] = pending_estimate[1]
             pending_estimate = None
         elif kind == "SYSTEM_TIME" and message.time_boot_ms > 0:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
@@ -238,8 +241,9 @@ def zone_steps(trace: RunTrace, world: World) -> dict[int, list[float]]:
 
 
 def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
-    """(times, |xhat - x|) of the work UAV at every cycle whose truth is known."""
-    times = trace.cycle_times
+    """(times, |xhat - x|) of the work UAV at every cycle with an estimate (not blind) whose
+    truth is known."""
+    times = sorted(trace.estimates)
     truth, known = trace.truth_at(1, times)
     estimates = np.array([trace.estimates[t] for t in times]).reshape(-1, 3)
     errors = np.linalg.norm(estimates[known] - truth[known], axis=1)
@@ -260,7 +264,7 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "completed": trace.completion is not None,
         "completion_time_s": trace.completion,
         "stopped": trace.stopped,
-        "control_cycles": len(trace.estimates),
+        "control_cycles": len(trace.cycles),
         "multipath_steps": counts,
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": _stats([float(e) for e in errors]),

@@ -1,6 +1,8 @@
 """How close a run came, from the truth in its tlog: the closest approach of every pair of UAVs,
 each UAV's least clearance from the structure and the ground, the control cycles at which a
-margin was broken, the contacts the vehicles reported, and the worst moments.
+margin was broken, the contacts the vehicles reported, the pairs and vehicles whose truth
+touched (whether or not a vehicle said so: a run with ``stop_on_crash`` false flies on), and
+the worst moments.
 
 Between two truth samples each vehicle is taken to fly straight (as it does in a step): a pair's
 closest approach over the interval is exact for that motion
@@ -127,6 +129,8 @@ def safety_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         gaps = np.full(len(cycles), np.inf)
         gaps[known] = proximity.clearance(positions[known])
         below_clearance |= gaps < clearance
+    touching_pairs = sorted(p for p, d in approaches.items() if d < 2 * radius)
+    touching_vehicles = sorted(v for v, d in clearances.items() if d < radius)
     return {
         "radius_m": radius,
         "min_separation_m": separation,
@@ -135,9 +139,13 @@ def safety_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "least_clearance_m": clearances,
         "cycles_below_separation": int(below_separation.sum()),
         "cycles_below_clearance": int(below_clearance.sum()),
+        "closest_approach_min_m": min(approaches.values(), default=None),
+        "least_clearance_min_m": min(clearances.values(), default=None),
         "contacts": trace.contacts,
-        "touching_pairs": sorted(p for p, d in approaches.items() if d < 2 * radius),
-        "touching_vehicles": sorted(v for v, d in clearances.items() if d < radius),
+        "contacts_reported": len(trace.contacts),
+        "touching_pairs": touching_pairs,
+        "touching_vehicles": touching_vehicles,
+        "touching": len(touching_pairs) + len(touching_vehicles),
         "worst_approach": worst_pair,
         "worst_clearance": worst_clear,
     }

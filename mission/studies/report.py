@@ -22,6 +22,9 @@ METRICS = (
     ("inclusion_rate", "fused while in a zone"),
     ("diagnostics.empty_s_cycles", "cycles with S empty"),
     ("diagnostics.time_beyond_flight_s", "time beyond pure flight [s]"),
+    ("safety.closest_approach_min_m", "closest approach of two UAVs [m]"),
+    ("safety.least_clearance_min_m", "least clearance of a UAV [m]"),
+    ("safety.touching", "contacts (from the truth)"),
 )
 PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
 

@@ -124,6 +124,8 @@ def _one_line(summary: dict[str, Any]) -> str:
     done = (
         f"completed at {summary['completion_time_s']:.1f} s"
         if summary["completed"]
+        else f"STOPPED ({summary['stopped']})"
+        if summary.get("stopped")
         else "NOT completed"
     )
     return (

@@ -10,6 +10,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from mission.viewer import frame as f
+from mission.viewer.safety_rows import SafetyRows
 from mission.world.model import World
 
 
@@ -34,7 +35,8 @@ class CycleRows:
         self.times: list[float] = []  # every cycle's time so far
         self.zone_steps = {n: 0 for n in run.names.values() if n != "work"}
         self._waypoint: int | None = None
-        self._pending: list[tuple[float, np.ndarray]] = []  # (t, xhat) awaiting the truth
+        self._pending: list[tuple[float, np.ndarray | None]] = []  # (t, xhat) awaiting truth
+        self.safety = SafetyRows(run.world, list(run.names.values()))
 
     def add(self, records: list[dict[str, Any]], out: f.Frame) -> None:
         for record in records:
@@ -56,7 +58,7 @@ class CycleRows:
                     path = np.array(solve["path"], dtype=float).reshape(-1, 3)
                     out.strips[f.mpc_path(name)].add(t, path, f.colour_of(name))
             self._current_waypoint(int(record["k"]), t, out)
-            self._pending.append((t, xhat))
+            self._pending.append((t, None if record.get("blind") else xhat))
 
     def _current_waypoint(self, k: int, t: float, out: f.Frame) -> None:
         """Each vehicle's current waypoint w_{n,k}, logged when k changes."""
@@ -69,7 +71,7 @@ class CycleRows:
                 out.points[f.current_waypoint_path(name)].add(t, point, f.colour_of(name))
 
     def resolve(self, out: f.Frame, final: bool) -> None:
-        """The error and steps in a zone of the cycles whose truth has come."""
+        """The error, the steps in a zone and the margins of the cycles whose truth has come."""
         names = list(self.run.tracks)
         ready = [(t, x) for t, x in self._pending if self.run.ready(names, t, final)]
         self._pending = self._pending[len(ready) :]
@@ -78,9 +80,13 @@ class CycleRows:
         times = [t for t, _ in ready]
         truth, known = self.run.truth_at("work", times)
         for (t, xhat), position, ok in zip(ready, truth, known):
-            if ok:
+            if ok and xhat is not None:  # a blind cycle has no estimate to be wrong
                 error = float(np.linalg.norm(xhat - position))
                 out.scalars[f.scalar_path("work_error")].add(t, error)
+        at = {name: self.run.truth_at(name, times) for name in names}
+        for i, t in enumerate(times):
+            known = {name: p[i] for name, (p, k) in at.items() if k[i]}
+            self.safety.add(t, known, out)
         for name in self.zone_steps:
             positions, known = self.run.truth_at(name, times)
             inside = np.zeros(len(times), dtype=bool)

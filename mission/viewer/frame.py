@@ -33,6 +33,7 @@ IN_ZONE_FIX_COLOUR: Rgb = ZONE_COLOUR  # a GNSS fix taken inside a multipath zon
 UNKNOWN_COLOUR: Rgb = (200, 200, 200)  # a fix whose truth is not in the log
 VISIBLE_COLOUR: Rgb = (224, 224, 224)
 BLOCKED_COLOUR: Rgb = (255, 112, 67)
+BELOW_MARGIN_COLOUR: Rgb = (213, 0, 0)  # two UAVs closer than the separation margin
 G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)
 G_CHANGED_M = 0.01  # a voxel is shown once G differs from its initial value by this much
 
@@ -77,11 +78,17 @@ def current_waypoint_path(name: str) -> str:
 
 def scalar_path(kind: str, name: str | None = None) -> str:
     """``plots/work_error``, ``plots/beta/support-1``, ``plots/solve_ms/...``,
-    ``plots/zone_steps/...``, ``plots/fused/...``."""
+    ``plots/zone_steps/...``, ``plots/fused/...``, ``plots/margins/closest_approach``."""
     return f"plots/{kind}" if name is None else f"plots/{kind}/{name}"
 
 
+def below_margin_path(first: str, second: str) -> str:
+    """The line between two UAVs closer than the separation margin."""
+    return f"safety/below_separation/{first}-{second}"
+
+
 G_PATH = "map/G"
+WORST_PATH = "safety/worst_approach"  # between the two UAVs of the worst approach so far
 
 
 @dataclass

@@ -56,6 +56,7 @@ def blueprint(scene: Scene) -> rrb.Blueprint:
         rrb.TimeSeriesView(name="beta_n", origin="/plots/beta", plot_legend=hidden),
         rrb.TimeSeriesView(name="fused (in S)", origin="/plots/fused", plot_legend=hidden),
         rrb.TimeSeriesView(name="MPC solve (ms)", origin="/plots/solve_ms", plot_legend=hidden),
+        rrb.TimeSeriesView(name="closest approach, least clearance (m)", origin="/plots/margins"),
     )
     return rrb.Blueprint(
         rrb.Horizontal(
