@@ -123,6 +123,8 @@ class RunAssembler:
             t = truth_time(item.stamp_usec, self.epoch_usec, offset)
             name = self.names[item.system]
             if item.kind == "truth":
+                if t <= self.tracks[name].last:  # a step's telemetry sent again (lockstep)
+                    continue
                 self.tracks[name].times.append(t)
                 self.tracks[name].positions.append(item.value)
                 out.points[f.uav_path(name)].add(t, item.value, f.colour_of(name))
