@@ -110,7 +110,7 @@ def _add_bench_parser(commands) -> None:
     bench.add_argument(
         "--only",
         action="append",
-        choices=["world", "vehicle", "gcs", "run", "study", "view"],
+        choices=["world", "vehicle", "gcs", "margins", "run", "study", "view"],
         help="run only this group (repeatable)",
     )
 

@@ -17,6 +17,7 @@ from typing import Any
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.runs.bench_margins import bench_margins
 from mission.runs.bench_result import BenchResult
 from mission.runs.bench_study import bench_studies
 from mission.runs.bench_view import bench_view
@@ -317,6 +318,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "world": bench_sigma0_map,
     "vehicle": bench_vehicle,
     "gcs": bench_ground_station,
+    "margins": bench_margins,
     "run": bench_runs,
     "study": bench_studies,
     "view": bench_view,

@@ -166,3 +166,25 @@ def test_a_blind_work_uav_holds_where_it_is(tmp_path):
     assert drift < 1e-3  # tracking noise is 0: not a millimetre
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["diagnostics"]["blind_cycles"] == len(records)
+
+
+def test_the_defaults_keep_their_margins_along_the_whole_run(tmp_path):
+    """Along AC seed 0 with the defaults: no contact, and the truth (read by pymavlink) keeps
+    every pair 2 m apart and every UAV 0.5 m from the structure (trimesh) and the ground, at
+    every sample."""
+    result = _mission("run", "along", "--out", str(tmp_path / "run"))
+    assert result.returncode == 0, result.stderr
+    scenario = load_scenario("along")
+    control = scenario.control
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["completed"] and summary["safety"]["contacts"] == []
+    tracks = _independent_truth(tmp_path / "run" / "gcs.tlog", scenario)
+    for a, b in itertools.combinations(sorted(tracks), 2):
+        times = np.intersect1d(tracks[a][0], tracks[b][0])
+        pa = tracks[a][1][np.searchsorted(tracks[a][0], times)]
+        pb = tracks[b][1][np.searchsorted(tracks[b][0], times)]
+        assert np.linalg.norm(pa - pb, axis=1).min() >= control.min_separation_m
+    query = trimesh.proximity.ProximityQuery(World(scenario).structure.mesh)
+    for _, positions in tracks.values():
+        clearance = np.minimum(np.abs(query.signed_distance(positions)), positions[:, 2])
+        assert clearance.min() >= control.clearance_m
