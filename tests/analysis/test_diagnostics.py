@@ -24,6 +24,7 @@ def _trace(along) -> tuple[RunTrace, list[dict]]:
         trace.truth[(3, t)] = IN_ZONE if k == 6 else OPEN  # support-2
         trace.truth[(4, t)] = OPEN
         trace.ticks.add(t)
+        trace.cycles.add(t)  # the work UAV's setpoint of cycle k
         trace.estimates[t] = work + [0.1 * k, 0.0, 0.0]  # error 0.1 k
         consistent = ["support-1", "support-2", "support-3"] if k in (3, 6) else ["support-2"]
         records.append({"t": t, "consistent": consistent, "fallback": k == 3, "blind": False})

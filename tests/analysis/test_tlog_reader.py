@@ -78,3 +78,31 @@ def test_fast_reader_equals_pymavlinks_and_falls_back_on_foreign_bytes(tmp_path,
     assert sorted(fast.truth) == sorted(reference.truth) == [(2, 0.5), (2, 1.0)]
     for key in fast.truth:
         np.testing.assert_array_equal(fast.truth[key], reference.truth[key])
+
+
+def test_a_blind_cycle_is_a_cycle_without_an_estimate(tmp_path):
+    """The ground station streams no estimate on a blind cycle: the work UAV's setpoint alone
+    makes the cycle; the crash a vehicle reports and the station's stop are read too."""
+    scenario = load_scenario("along")
+    epoch = scenario.run.epoch_unix_s
+    records = [r for r in _records(epoch) if r[0] != epoch + 1.0] + [
+        r
+        for r in _records(epoch)
+        if r[0] == epoch + 1.0 and _kind(r[1]) != "VISION_POSITION_ESTIMATE"
+    ]
+    crash = mavlink2.MAVLink_statustext_message(0, b"Crash: structure t=0.81 at 1.0,-2.0,3.0")
+    stopped = mavlink2.MAVLink_statustext_message(6, b"Run stopped: support-1 crashed")
+    records += [(epoch + 1.0, _packet(2, crash)), (epoch + 1.0, _packet(255, stopped))]
+    tlog = tmp_path / "gcs.tlog"
+    _write(tlog, sorted(records, key=lambda r: r[0]))
+    trace = read_tlog(tlog, scenario)
+    assert trace.cycle_times == [0.5, 1.0] and sorted(trace.estimates) == [0.5]
+    assert trace.contacts == [
+        {"t": 0.81, "vehicle": "support-1", "with": "structure", "at_m": [1.0, -2.0, 3.0],
+         "crash": True}
+    ]  # fmt: skip
+    assert trace.stopped == "support-1 crashed at 1.0 s"
+
+
+def _kind(packet: bytes) -> str:
+    return mavlink2.MAVLink(None).decode(bytearray(packet)).get_type()
