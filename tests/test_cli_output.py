@@ -31,3 +31,15 @@ def test_a_run_that_did_not_complete_or_estimate_says_so():
     line = run_line(summary, 900.0)
     assert line.startswith("NOT completed within 900 s;")
     assert "work UAV error no estimate" in line
+
+
+def test_a_stopped_run_says_why_and_every_run_says_how_close_it_came():
+    safety = {
+        "closest_approach_m": {"work/support-1": 2.85, "support-1/support-2": 3.4},
+        "least_clearance_m": {"work": 0.9, "support-1": 0.54},
+    }
+    summary = {**SUMMARY, "completed": False, "completion_time_s": None, "safety": safety}
+    summary["stopped"] = "support-1 crashed at 22.5 s"
+    line = run_line(summary, 900.0)
+    assert line.startswith("STOPPED: support-1 crashed at 22.5 s;")
+    assert line.endswith("; closest approach 2.85 m, least clearance 0.54 m")

@@ -1,0 +1,84 @@
+"""The support MPC keeps its margins over the whole horizon (checked on its plans against
+independent distances: numpy between UAVs, trimesh to the bridge) where the paper's form hugs
+the deck, and the work UAV waits rather than step into a margin."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from ground_station.models import build_models
+from ground_station.plan import plan, work_must_wait
+from ground_station.support_mpc import CONVERGED, SupportMpc
+from ground_station.work_mpc import predict_work
+from mission.config.scenario import load_scenario
+from mission.link.plan_files import read_plan
+from mission.world.model import KnownWorld, World
+
+
+def _mpc(world: World, others: int) -> SupportMpc:
+    return SupportMpc(
+        world.scenario.control, world.map_grid(), world.camera, world.sigma0_map().sigma_m,
+        others=others,
+    )  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def worlds():
+    safe = World(load_scenario("along"))
+    paper = World(load_scenario("along", {"control.min_separation_m": 0, "control.clearance_m": 0}))
+    return safe, paper
+
+
+def _squeezed(world: World, mpc: SupportMpc):
+    """Support 1 beside the deck's side (0.8 m from it) heading along it, with support 2
+    parked 3.7 m out from its path: the cheapest plan runs along the deck, close past support
+    2; the corridor between the two margins (1 m from the deck, 3 m from support 2) is open."""
+    plan_ = read_plan(world.scenario)
+    horizon = world.scenario.control.horizon_steps
+    yhat = np.array([-6.0, 5.8, 8.5])
+    waypoints = np.array([yhat + [2.0 * i, -0.3, 0.0] for i in range(15)])
+    work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
+    other = np.repeat([[-3.5, 9.5, 8.5]], horizon, axis=0)
+    others = np.array([work.path[:horizon], other, other + [0.0, 30.0, 0.0]])
+    request = mpc.request(
+        "support-1", yhat, waypoints, work.path, work.indices, world.sigma0_map().sigma_m,
+        others=others,
+    )  # fmt: skip
+    return mpc.plan(request, world.camera.observable), others
+
+
+def test_the_support_mpc_keeps_every_margin_over_its_horizon(worlds):
+    safe, paper = worlds
+    control = safe.scenario.control
+    allowance = control.estimate_allowance_m
+    query = trimesh.proximity.ProximityQuery(safe.structure.mesh)
+    kept, others = _squeezed(safe, _mpc(safe, 3))
+    assert kept.status == CONVERGED
+    apart = np.linalg.norm(kept.path[None] - others, axis=2).min()
+    assert apart >= control.min_separation_m + 2 * allowance - 1e-3
+    clear = np.abs(query.signed_distance(kept.path)).min()
+    assert clear >= control.clearance_m + allowance - 1e-3
+    free, _ = _squeezed(paper, _mpc(paper, 3))  # the paper's form hugs the deck
+    assert np.abs(query.signed_distance(free.path)).min() < control.clearance_m + allowance
+
+
+def test_the_work_uav_waits_rather_than_step_into_a_margin(along):
+    known = KnownWorld(along)
+    plan_ = read_plan(along)
+    waypoints = {
+        "work": plan_.work,
+        **{f"support-{n + 1}": s for n, s in enumerate(plan_.supports)},
+    }
+    models, state = build_models(known, waypoints, True, 0)
+    state.xhat = plan_.work[0].copy()
+    ahead = plan_.work[1] - plan_.work[0]
+    ahead /= np.linalg.norm(ahead)
+    state.yhat["support-1"] = state.xhat + 2.1 * ahead  # just outside 2 m; the next step is in
+    formation = plan(state, models, list(models.support_waypoints))
+    assert work_must_wait(state, state.xhat + 0.3 * ahead, models)
+    np.testing.assert_array_equal(formation.work.command, state.xhat)
+    state.yhat["support-1"] = state.xhat - 1.5 * ahead  # inside already, behind: stepping away
+    formation = plan(state, models, list(models.support_waypoints))
+    assert np.linalg.norm(formation.work.command - state.xhat) > 0.1
