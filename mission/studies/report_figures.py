@@ -81,9 +81,21 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
             if row_index == 0:
                 axis.set_title(scenario)
     handles, labels = axes[0][0].get_legend_handles_labels()
-    figure.legend(handles, labels, loc="upper right", fontsize=7)
-    figure.suptitle(f"{spec.name}: each metric against {key} (mean, 95 % CI)")
-    figure.tight_layout(rect=(0, 0, 0.85, 0.97))
+    # the title on top, the legend in two columns under it, the panels below both
+    height = figure.get_figheight()
+    legend_rows = -(-len(labels) // 2)
+    figure.suptitle(f"{spec.name}: each metric against {key} (mean, 95 % CI)", y=1 - 0.12 / height)
+    figure.legend(
+        handles,
+        labels,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 1 - 0.42 / height),
+        ncol=2,
+        fontsize=7,
+        frameon=False,
+    )
+    top = 1 - (0.55 + 0.2 * legend_rows) / height
+    figure.tight_layout(rect=(0, 0, 1, top))
     save_figure(figure, path)
 
 
