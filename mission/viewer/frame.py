@@ -34,6 +34,7 @@ UNKNOWN_COLOUR: Rgb = (200, 200, 200)  # a fix whose truth is not in the log
 VISIBLE_COLOUR: Rgb = (224, 224, 224)
 BLOCKED_COLOUR: Rgb = (255, 112, 67)
 BELOW_MARGIN_COLOUR: Rgb = (213, 0, 0)  # two UAVs closer than the separation margin
+WORST_COLOUR: Rgb = (20, 20, 20)  # the worst approach so far
 G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)
 G_CHANGED_M = 0.01  # a voxel is shown once G differs from its initial value by this much
 

@@ -1,7 +1,7 @@
 """The margins in the view, at each control cycle whose truth has come: the closest approach
 of any two UAVs and the least clearance of any UAV from the structure and the ground (plotted),
-a line between every pair closer than the separation margin, and a marker at the worst
-approach so far (the run's worst once it is over), as :mod:`mission.analysis.safety` counts
+a red line between every pair closer than the separation margin, and a black marker at the
+worst approach so far (the run's worst once it is over), as :mod:`mission.analysis.safety` counts
 them at the cycles."""
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ class SafetyRows:
             if closest < self.worst:
                 self.worst = closest
                 middle = (positions[a] + positions[b]) / 2
-                out.points[f.WORST_PATH].add(t, middle, f.BELOW_MARGIN_COLOUR)
+                out.points[f.WORST_PATH].add(t, middle, f.WORST_COLOUR)
         for a, b, distance in pairs:
             if distance < self.separation:
                 line = np.vstack([positions[a], positions[b]])

@@ -89,7 +89,7 @@ def send_frame(rec: rr.RecordingStream, frame: f.Frame, scene: Scene) -> None:
         ).partition(np.ones(len(rows.times), dtype=np.int32))
         _send(rec, path, rows.times, columns)
     for path, rows in frame.strips.items():
-        radius = 0.05 if path.startswith("mpc/") else 0.025
+        radius = 0.05 if path.startswith(("mpc/", "safety/")) else 0.025
         columns = rr.LineStrips3D.columns(
             strips=[np.asarray(strip, dtype=float) for strip in rows.values],
             colors=np.array(rows.colours, dtype=np.uint8).reshape(-1, 3),
