@@ -24,7 +24,6 @@ from mission.config.settings import ControlSettings
 from mission.world.proximity import StructureProximity
 from mission.world.structure import Structure
 
-STRUCTURE_SLOTS = 3  # the nearest structure pieces each step considers
 SLOTS = 3  # half-spaces a step keeps, the nearest to binding at the guess (fewer rows)
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -42,12 +41,9 @@ class Margins:
             self.clearance += allowance
         self.proximity = StructureProximity(structure)
         self.other_slots = others if self.separation > 0 else 0
-        self.structure_slots = (
-            min(self.proximity.pieces, STRUCTURE_SLOTS) if self.clearance > 0 else 0
-        )
-        ground = 1 if self.clearance > 0 else 0
-        self.candidates = self.other_slots + self.structure_slots + ground
-        self.slots = min(self.candidates, SLOTS)
+        # every structure piece and the ground are candidates; a step keeps the SLOTS nearest
+        pieces = self.proximity.pieces + 1 if self.clearance > 0 else 0
+        self.slots = min(self.other_slots + pieces, SLOTS)
         self._reach_m = self.clearance + (control.horizon_steps + 1) * control.d_max_support_m
 
     def parameters(self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray) -> np.ndarray:
@@ -65,7 +61,7 @@ class Margins:
             normals.append(n)
             offsets.append(b)
         if self.clearance > 0:
-            if self.structure_slots:
+            if self.proximity.pieces:
                 distance, closest, n = self.proximity.closest(guess)
                 far = distance > self._reach_m
                 n[far] = 0.0

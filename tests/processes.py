@@ -37,6 +37,17 @@ class VehicleProcess:
         return stop_process(self.process)
 
 
+def mission(*arguments: str) -> subprocess.CompletedProcess:
+    """``python -m mission ARGUMENTS`` from the repository's root, its output captured."""
+    return subprocess.run(
+        [sys.executable, "-m", "mission", *arguments],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
+
+
 def vehicle_pids(parent: int, vehicle: str) -> list[int]:
     """The pids of ``parent``'s vehicle processes named ``vsim-VEHICLE`` (each vehicle names
     itself so, whether `mission run` forked it or started it as ``python -m vehicle_sim``)."""

@@ -7,14 +7,12 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.processes import ROOT
+from tests.processes import mission
 from tests.runs.test_run import SHORT
 from tests.runs.test_run import _records as _steady_records
 
@@ -27,16 +25,6 @@ pytestmark = pytest.mark.slow  # every test here starts processes
 LOCKSTEP_RECORDS_SHA256 = "5a1c68f7c291e624"
 
 
-def _mission(*arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "mission", *arguments],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=ROOT,
-    )
-
-
 def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
     """In the paper's form (no margins, contacts flown through), as the digest was taken."""
     scenario = tmp_path / "short-run.yaml"
@@ -45,8 +33,8 @@ def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
         SHORT.replace("run: {timeout_s: 120.0}", "run: {timeout_s: 120.0, stop_on_crash: false}")
         + paper_form
     )
-    assert _mission("plan", str(scenario)).returncode == 0
-    result = _mission("run", str(scenario), "--out", str(tmp_path / "run"))
+    assert mission("plan", str(scenario)).returncode == 0
+    result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     records = _steady_records(tmp_path / "run")
     assert all("age_ms" not in record for record in records)
@@ -106,7 +94,7 @@ def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lo
     from mission.world.model import World
 
     realtime = tmp_path / "realtime"
-    result = _mission("run", "along", "--realtime", "--speedup", "10", "--out", str(realtime))
+    result = mission("run", "along", "--realtime", "--speedup", "10", "--out", str(realtime))
     assert result.returncode == 0, result.stderr
     summary = json.loads((realtime / "summary.json").read_text())
     assert summary["completed"] is True
@@ -131,7 +119,7 @@ def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lo
     assert summary["work_error_m"]["mean"] == pytest.approx(float(np.mean(errors)), abs=0.001)
 
     lockstep = tmp_path / "lockstep"
-    assert _mission("run", "along", "--out", str(lockstep)).returncode == 0
+    assert mission("run", "along", "--out", str(lockstep)).returncode == 0
     reference = json.loads((lockstep / "summary.json").read_text())
     assert summary["work_error_m"]["mean"] == pytest.approx(
         reference["work_error_m"]["mean"], rel=0.15

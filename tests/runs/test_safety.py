@@ -9,8 +9,6 @@ import hashlib
 import itertools
 import json
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +18,7 @@ import trimesh
 from mission.config.scenario import load_scenario
 from mission.world.frames import GeodeticFrame
 from mission.world.model import World
-from tests.processes import ROOT
+from tests.processes import mission
 from tests.runs.test_run import _records
 
 pytestmark = pytest.mark.slow  # every test here starts processes
@@ -37,16 +35,6 @@ run: {{stop_on_crash: {stop}}}
 PAPER_FORM_RECORDS = (509, "7ce94cd2d0a9c0c1")
 
 
-def _mission(*arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "mission", *arguments],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=ROOT,
-    )
-
-
 def _paper_form(tmp_path: Path, stop: bool) -> Path:
     path = tmp_path / f"paper-form-{stop}.yaml"
     path.write_text(PAPER_FORM.format(stop=str(stop).lower()))
@@ -54,7 +42,7 @@ def _paper_form(tmp_path: Path, stop: bool) -> Path:
 
 
 def test_the_papers_form_is_one_setting_away(tmp_path):
-    result = _mission("run", str(_paper_form(tmp_path, False)), "--out", str(tmp_path / "run"))
+    result = mission("run", str(_paper_form(tmp_path, False)), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     records = _records(tmp_path / "run")
     digest = hashlib.sha256(json.dumps(records, sort_keys=True).encode()).hexdigest()[:16]
@@ -72,7 +60,7 @@ def crashed(tmp_path_factory) -> tuple[Path, Path]:
     the first crash."""
     tmp = tmp_path_factory.mktemp("crash")
     out, scenario = tmp / "run", _paper_form(tmp, True)
-    result = _mission("run", str(scenario), "--out", str(out))
+    result = mission("run", str(scenario), "--out", str(out))
     assert result.returncode == 0, result.stderr
     assert "STOPPED: support-1 crashed" in result.stdout
     return out, scenario
@@ -153,7 +141,7 @@ def test_a_blind_work_uav_holds_where_it_is(tmp_path):
     station streams it no estimate, and its truth does not move."""
     path = tmp_path / "blind.yaml"
     path.write_text(BLIND)
-    result = _mission("run", str(path), "--out", str(tmp_path / "run"))
+    result = mission("run", str(path), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     records = [
         json.loads(line) for line in (tmp_path / "run/records.jsonl").read_text().splitlines()
@@ -172,7 +160,7 @@ def test_the_defaults_keep_their_margins_along_the_whole_run(tmp_path):
     """Along AC seed 0 with the defaults: no contact, and the truth (read by pymavlink) keeps
     every pair 2 m apart and every UAV 0.5 m from the structure (trimesh) and the ground, at
     every sample."""
-    result = _mission("run", "along", "--out", str(tmp_path / "run"))
+    result = mission("run", "along", "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     scenario = load_scenario("along")
     control = scenario.control

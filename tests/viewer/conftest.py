@@ -2,26 +2,13 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from tests.processes import ROOT
+from tests.processes import mission
 from tests.runs.test_run import SHORT
 from tests.viewer.rrd import read_rrd
-
-
-def mission(*arguments: str) -> subprocess.CompletedProcess:
-    """``python -m mission ARGUMENTS`` from the repository's root."""
-    return subprocess.run(
-        [sys.executable, "-m", "mission", *arguments],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=ROOT,
-    )
 
 
 @pytest.fixture(scope="session")
