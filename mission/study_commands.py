@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.procs.interrupts import StopRequest
 from mission.procs.outputs import check_output_dir
 from mission.subcommands import preflight, realtime_speedup
 
@@ -68,28 +68,18 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
     engine = _engine(args)
     # Ctrl-C and SIGTERM stop the study, even where it was started with SIGINT ignored (in the
     # background): then `kill -INT` cancels it as Ctrl-C would.
-    previous = {
-        signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
-        signal.SIGTERM: signal.signal(signal.SIGTERM, _raise_interrupt),
-    }
     try:
-        outcome = run_study(spec, out, engine, args.keep, runs_dir=args.runs)
+        with StopRequest():
+            outcome = run_study(spec, out, engine, args.keep, runs_dir=args.runs)
     except KeyboardInterrupt:
         print(f"study interrupted; finished runs are kept in {out}: run it again to resume")
         return 130
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
     print(
         f"{outcome.finished} runs finished, {outcome.skipped} already done, "
         f"{len(outcome.failed)} failed; wall {outcome.wall_time_s:.1f} s; "
         f"results in {out / 'results.csv'}, report in {out / 'report.md'}"
     )
     return 1 if outcome.failed else 0
-
-
-def _raise_interrupt(*_: object) -> None:
-    raise KeyboardInterrupt
 
 
 def _check_scenarios(spec) -> dict[str, str]:

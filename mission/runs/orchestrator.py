@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import re
-import signal
 import socket
 import subprocess
 import sys
@@ -30,6 +29,7 @@ from mission.link.plan_files import vehicle_names
 from mission.procs.atomic import write_text_atomically
 from mission.procs.cli_common import child_environment
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
+from mission.procs.interrupts import StopRequest
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
 SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
@@ -89,21 +89,17 @@ def run_mission(
     start = time.monotonic()
     # Ctrl-C and SIGTERM stop the run, even where the caller started it with SIGINT ignored
     # (a background job): its forked children take Python's default handlers back.
-    previous = {
-        signal.SIGTERM: signal.signal(signal.SIGTERM, _raise_interrupt),
-        signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
-    }
-    try:
-        gcs = _start_processes(options, scenario, children)
-        _supervise(gcs, children, {"work"}, watcher)
-        if gcs.process.returncode != 0:
-            raise RunFailed(
-                f"ground_station exited with status {gcs.process.returncode} (see {gcs.log})"
-            )
-    finally:
-        _stop_all(children)
-        for number, handler in previous.items():
-            signal.signal(number, handler)
+    with StopRequest() as stop:
+        try:
+            gcs = _start_processes(options, scenario, children)
+            _supervise(gcs, children, {"work"}, watcher, stop)
+            if gcs.process.returncode != 0:
+                raise RunFailed(
+                    f"ground_station exited with status {gcs.process.returncode} (see {gcs.log})"
+                )
+        finally:
+            _stop_all(children)
+        stop.check()  # a request whose exception was swallowed: the run was cancelled
     if watcher is not None:
         watcher.finish()
     summary = _summary(options, scenario, time.monotonic() - start)
@@ -194,10 +190,6 @@ def _flag(name: str, on: bool) -> str:
     return f"--{name}" if on else f"--no-{name}"
 
 
-def _raise_interrupt(*_: Any) -> None:
-    raise KeyboardInterrupt
-
-
 def _bound_udp() -> socket.socket:
     """A UDP socket bound to a free loopback port."""
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
@@ -238,13 +230,18 @@ def _launch(
 
 
 def _supervise(
-    gcs: Child, children: list[Child], required: set[str], watcher: RunWatcher | None
+    gcs: Child,
+    children: list[Child],
+    required: set[str],
+    watcher: RunWatcher | None,
+    stop: StopRequest,
 ) -> None:
     """Wait for the ground station; a dead required vehicle, or one that never started,
     ends the run with an error. What the ground station says of a first run's compilation is
     shown as it comes; the watcher is polled."""
     relay = LogRelay(gcs.log, COMPILE_NEWS)
     while True:
+        stop.check()
         try:
             gcs.process.wait(timeout=SUPERVISE_S)
             relay.poll()

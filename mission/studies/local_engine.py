@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import os
-import signal
 import subprocess
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from mission.procs.interrupts import StopRequest
 from mission.studies.execute import Keep, conclude, prepare, start, this_node
 from mission.studies.runkeys import StudyRun
 
@@ -40,25 +40,25 @@ class LocalEngine:
         running: dict[StudyRun, tuple[subprocess.Popen, float]] = {}
         mpc_helper = helper_has_a_core(self.jobs, os.cpu_count() or 1)
         node = this_node()
-        previous = signal.signal(signal.SIGTERM, _raise_interrupt)
-        try:
-            while queue or running:
-                while queue and len(running) < self.jobs:
-                    run = queue.pop(0)
-                    prepare(run, runs_dir / run.folder)
-                    process = start(run, runs_dir / run.folder, mpc_helper)
-                    running[run] = (process, time.monotonic())
-                for run, (process, started) in list(running.items()):
-                    if process.poll() is None:
-                        continue
-                    del running[run]
-                    wall = time.monotonic() - started
-                    status = process.returncode
-                    done(run, conclude(run, runs_dir / run.folder, status, node, keep), wall)
-                time.sleep(POLL_S)
-        finally:
-            signal.signal(signal.SIGTERM, previous)
-            _stop(process for process, _ in running.values())
+        with StopRequest() as stop:
+            try:
+                while queue or running:
+                    stop.check()  # a request whose exception was swallowed (in a fork)
+                    while queue and len(running) < self.jobs:
+                        run = queue.pop(0)
+                        prepare(run, runs_dir / run.folder)
+                        process = start(run, runs_dir / run.folder, mpc_helper)
+                        running[run] = (process, time.monotonic())
+                    for run, (process, started) in list(running.items()):
+                        if process.poll() is None:
+                            continue
+                        del running[run]
+                        wall = time.monotonic() - started
+                        status = process.returncode
+                        done(run, conclude(run, runs_dir / run.folder, status, node, keep), wall)
+                    time.sleep(POLL_S)
+            finally:
+                _stop(process for process, _ in running.values())
 
 
 def _stop(processes) -> None:
@@ -71,7 +71,3 @@ def _stop(processes) -> None:
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
-
-
-def _raise_interrupt(*_: object) -> None:
-    raise KeyboardInterrupt
