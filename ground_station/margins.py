@@ -18,6 +18,8 @@ others' plans as they stood).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from mission.config.settings import ControlSettings
@@ -25,7 +27,8 @@ from mission.world.proximity import StructureProximity
 from mission.world.structure import Structure
 
 SLOTS = 3  # half-spaces a step keeps, the nearest to binding at the guess (fewer rows)
-UP = np.array([0.0, 0.0, 1.0])
+Space = tuple[tuple[float, float, float], float]  # n, b of the half-space n.v >= b
+UNUSED: Space = ((0.0, 0.0, 0.0), -1.0)  # a slot no half-space fills
 
 
 class Margins:
@@ -45,61 +48,95 @@ class Margins:
         pieces = self.proximity.pieces + 1 if self.clearance > 0 else 0
         self.slots = min(self.other_slots + pieces, SLOTS)
         self._reach_m = self.clearance + (control.horizon_steps + 1) * control.d_max_support_m
+        self._boxes = [
+            (low.tolist(), high.tolist())
+            for low, high in zip(self.proximity.low, self.proximity.high, strict=True)
+        ]
 
     def parameters(self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray) -> np.ndarray:
         """The NLP's margin parameters for a guess (U, 3): every step's normals (column by
         column of the (3, U slots) matrix), then their offsets. ``others`` (m, U, 3): the other
         UAVs' predicted positions. Each step keeps the ``slots`` half-spaces nearest to
-        binding at the guess (least n.g - b); a slot left over is unused (n = 0, b = -1)."""
+        binding at the guess (least n.g - b; on a tie, and with no more than ``slots``, in
+        the order others, structure pieces, ground); a slot left over is unused (n = 0,
+        b = -1).
+
+        Five points and a few dozen half-spaces: in plain floats this takes half the time
+        numpy's per-call overhead makes it take (86 against 176 us on Along's problems)."""
         if self.slots == 0:
             return np.zeros(0)
-        horizon = len(guess)
-        normals, offsets = [], []
-        others = np.asarray(others, dtype=float)[: self.other_slots]
-        if len(others):
-            n, b = self._apart(guess, yhat, others)
-            normals.append(n)
-            offsets.append(b)
-        if self.clearance > 0:
-            if self.proximity.pieces:
-                distance, closest, n = self.proximity.closest(guess)
-                far = distance > self._reach_m
-                n[far] = 0.0
-                b = np.einsum("usk,usk->us", n, closest) + self.clearance
-                b[far] = -1.0
-                normals.append(n)
-                offsets.append(b)
-            normals.append(np.broadcast_to(UP, (horizon, 1, 3)))
-            offsets.append(np.full((horizon, 1), self.clearance))
-        normals, offsets = np.concatenate(normals, axis=1), np.concatenate(offsets, axis=1)
-        if normals.shape[1] > self.slots:
-            gap = np.einsum("usk,uk->us", normals, guess) - offsets
-            keep = np.argsort(gap, axis=1, kind="stable")[:, : self.slots]
-            rows = np.arange(horizon)[:, None]
-            normals, offsets = normals[rows, keep], offsets[rows, keep]
-        elif normals.shape[1] < self.slots:
-            missing = self.slots - normals.shape[1]
-            normals = np.concatenate([normals, np.zeros((horizon, missing, 3))], axis=1)
-            offsets = np.concatenate([offsets, np.full((horizon, missing), -1.0)], axis=1)
-        return np.concatenate([normals.reshape(-1), offsets.reshape(-1)])
+        points = np.asarray(guess, dtype=float).tolist()
+        others = np.asarray(others, dtype=float)[: self.other_slots].tolist()
+        pieces = self._pieces(guess) if self.clearance > 0 else [[] for _ in points]
+        start = np.asarray(yhat, dtype=float).tolist()
+        normals: list[float] = []
+        offsets: list[float] = []
+        for step, point in enumerate(points):
+            spaces = [self._apart(point, start, other[step]) for other in others]
+            spaces += pieces[step]
+            if self.clearance > 0:
+                spaces.append(((0.0, 0.0, 1.0), self.clearance))  # the ground
+            if len(spaces) > self.slots:
+                spaces.sort(key=lambda space: _dot(space[0], point) - space[1])  # stable
+                spaces = spaces[: self.slots]
+            spaces += [UNUSED] * (self.slots - len(spaces))
+            for normal, offset in spaces:
+                normals.extend(normal)
+                offsets.append(offset)
+        return np.array(normals + offsets)
 
-    def _apart(
-        self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Per step (rows) and other UAV (columns), the half-space at ``separation`` beyond
-        the other's position facing the guess (from yhat where the guess sits on it;
-        straight up where both do)."""
-        other = others.transpose(1, 0, 2)  # (U, m, 3)
-        away = guess[:, None] - other
-        length = np.sqrt(np.einsum("usk,usk->us", away, away))
-        flat = length < 1e-9
-        if flat.any():
-            away[flat] = (yhat - other)[flat]
-            length[flat] = np.linalg.norm(away[flat], axis=1)
-            still = length < 1e-9
-            away[still], length[still] = UP, 1.0
-        normals = away / length[..., None]
-        return normals, np.einsum("usk,usk->us", normals, other) + self.separation
+    def _apart(self, point: list[float], start: list[float], other: list[float]) -> Space:
+        """The half-space at ``separation`` beyond the other UAV's position facing the guess
+        (from yhat where the guess sits on it; straight up where both do)."""
+        away = [point[k] - other[k] for k in range(3)]
+        length = math.sqrt(_dot(away, away))
+        if length < 1e-9:
+            away = [start[k] - other[k] for k in range(3)]
+            length = math.sqrt(_dot(away, away))
+            if length < 1e-9:
+                away, length = [0.0, 0.0, 1.0], 1.0
+        normal = (away[0] / length, away[1] / length, away[2] / length)
+        return normal, _dot(normal, other) + self.separation
+
+    def _pieces(self, guess: np.ndarray) -> list[list[Space]]:
+        """Per step, each structure piece's half-space at ``clearance`` beyond its point
+        closest to the guess (n = 0, b = -1 for a piece out of the horizon's reach)."""
+        distance, closest, normal = self._closest(guess)
+        spaces = []
+        for step in range(len(distance)):
+            row = []
+            for piece, gap in enumerate(distance[step]):
+                if gap > self._reach_m:
+                    row.append(UNUSED)
+                else:
+                    n = tuple(normal[step][piece])
+                    row.append((n, _dot(n, closest[step][piece]) + self.clearance))
+            spaces.append(row)
+        return spaces
+
+    def _closest(self, guess: np.ndarray) -> tuple[list, list, list]:
+        """What :meth:`StructureProximity.closest` gives, as nested lists: for boxes alone and
+        a guess outside every one of them, in plain floats (the same operations in the same
+        order, so the same values)."""
+        proximity = self.proximity
+        if proximity.has_file_mesh:
+            return tuple(array.tolist() for array in proximity.closest(guess))
+        distance, closest, normal = [], [], []
+        for point in np.asarray(guess, dtype=float).tolist():
+            gaps, points, normals = [], [], []
+            for low, high in self._boxes:
+                near = [min(max(point[k], low[k]), high[k]) for k in range(3)]
+                out = [point[k] - near[k] for k in range(3)]
+                gap = math.sqrt(_dot(out, out))
+                if gap == 0.0:  # on or inside a box: the general code
+                    return tuple(array.tolist() for array in proximity.closest(guess))
+                gaps.append(gap)
+                points.append(near)
+                normals.append([out[0] / gap, out[1] / gap, out[2] / gap])
+            distance.append(gaps)
+            closest.append(points)
+            normal.append(normals)
+        return distance, closest, normal
 
     def slack_guess(self, guess: np.ndarray, parameters: np.ndarray) -> np.ndarray:
         """Each step's largest violation at the guess (the slacks' starting point)."""
@@ -109,3 +146,9 @@ class Margins:
         offsets = parameters[3 * count :].reshape(horizon, self.slots)
         violation = offsets - np.einsum("usk,uk->us", normals, guess)
         return np.maximum(violation.max(axis=1), 0.0)
+
+
+def _dot(a, b) -> float:
+    """a.b of two 3-vectors, summed left to right (the same on every CPU; numpy's einsum
+    sums in an order its SIMD width picks)."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]

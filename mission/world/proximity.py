@@ -41,6 +41,11 @@ class StructureProximity:
             self._file_solid = structure.solid_file_mesh
 
     @property
+    def has_file_mesh(self) -> bool:
+        """Whether a mesh file is one of the pieces (not in closed form)."""
+        return self._file_mesh is not None
+
+    @property
     def pieces(self) -> int:
         """How many convex pieces (boxes, and the mesh file as one)."""
         return len(self.low) + (self._file_mesh is not None)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from ground_station.margins import SLOTS, Margins
 from ground_station.models import build_models
 from ground_station.plan import plan, work_must_wait
 from ground_station.support_mpc import CONVERGED, SupportMpc
@@ -82,3 +83,61 @@ def test_the_work_uav_waits_rather_than_step_into_a_margin(along):
     state.yhat["support-1"] = state.xhat - 1.5 * ahead  # inside already, behind: stepping away
     formation = plan(state, models, list(models.support_waypoints))
     assert np.linalg.norm(formation.work.command - state.xhat) > 0.1
+
+
+def _reference_half_spaces(margins, guess, yhat, others):
+    """The half-spaces of each step from the definition, in numpy: every other UAV's, every
+    structure piece's (the general closest-point code) and the ground's, the ``slots`` least
+    slack at the guess kept (stable), unused slots padded."""
+    distance, closest, normal = margins.proximity.closest(guess)
+    rows = []
+    for u, g in enumerate(guess):
+        spaces = []
+        for other in others[: margins.other_slots]:
+            away = g - other[u]
+            n = away / np.linalg.norm(away)
+            spaces.append((n, n @ other[u] + margins.separation))
+        if margins.clearance > 0:
+            for piece in range(margins.proximity.pieces):
+                if distance[u, piece] > margins._reach_m:
+                    spaces.append((np.zeros(3), -1.0))
+                else:
+                    n = normal[u, piece]
+                    spaces.append((n, n @ closest[u, piece] + margins.clearance))
+            spaces.append((np.array([0.0, 0.0, 1.0]), margins.clearance))
+        if len(spaces) > margins.slots:
+            order = np.argsort([n @ g - b for n, b in spaces], kind="stable")
+            spaces = [spaces[i] for i in order[: margins.slots]]
+        spaces += [(np.zeros(3), -1.0)] * (margins.slots - len(spaces))
+        rows.append(spaces)
+    normals = [n for row in rows for n, _ in row]
+    return np.concatenate([np.ravel(normals), [b for row in rows for _, b in row]])
+
+
+@pytest.mark.parametrize("structure", ["boxes", "mesh file"])
+def test_the_half_spaces_are_those_of_their_definition(structure, write_scenario, tmp_path):
+    """Random guesses, some inside the structure, against :func:`_reference_half_spaces`."""
+    if structure == "boxes":
+        world = World(load_scenario("along"))
+    else:
+        roof = trimesh.creation.box(extents=[40.0, 6.0, 1.0])
+        roof.apply_translation([0.0, 0.0, 8.5])
+        roof.export(str(tmp_path / "roof.stl"))
+        world = World(load_scenario(write_scenario(
+            "world: {structure: {mesh_file: roof.stl, primitives: [{name: post, min_m: [-2, -8, 0], "
+            "max_m: [2, -6, 8]}]}}\n"
+        )))  # fmt: skip
+    margins = Margins(world.scenario.control, world.structure, others=3)
+    assert margins.slots == SLOTS
+    rng = np.random.default_rng(4)
+    deck = world.structure.boxes[0]
+    for trial in range(300):
+        guess = rng.uniform([-15, -10, 0.2], [15, 10, 12], (5, 3))
+        if trial % 5 == 0:  # a step inside a box
+            guess[2] = rng.uniform(deck.min_m, deck.max_m)
+        yhat = rng.uniform([-15, -10, 0.2], [15, 10, 12])
+        others = rng.uniform([-15, -10, 0.2], [15, 10, 12], (3, 5, 3))
+        ours = margins.parameters(guess, yhat, others)
+        np.testing.assert_allclose(
+            ours, _reference_half_spaces(margins, guess, yhat, others), rtol=0, atol=1e-12
+        )
