@@ -34,14 +34,18 @@ def worlds():
 
 def _squeezed(world: World, mpc: SupportMpc):
     """Support 1 beside the deck's side (0.8 m from it) heading along it, with support 2
-    parked 3.7 m out from its path: the cheapest plan runs along the deck, close past support
-    2; the corridor between the two margins (1 m from the deck, 3 m from support 2) is open."""
+    parked out from its path: the cheapest plan runs along the deck, close past support 2; the
+    corridor between the two margins (as the safe settings plan them, from the deck and from
+    support 2) is open, 0.5 m wide."""
     plan_ = read_plan(world.scenario)
+    control = load_scenario("along").control  # the safe settings place support 2
+    allowance = control.estimate_allowance_m
+    corridor = control.clearance_m + allowance + control.min_separation_m + 2 * allowance + 0.5
     horizon = world.scenario.control.horizon_steps
     yhat = np.array([-6.0, 5.8, 8.5])
     waypoints = np.array([yhat + [2.0 * i, -0.3, 0.0] for i in range(15)])
     work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
-    other = np.repeat([[-3.5, 9.5, 8.5]], horizon, axis=0)
+    other = np.repeat([[-3.5, 5.0 + corridor, 8.5]], horizon, axis=0)  # the deck's side: y = 5
     others = np.array([work.path[:horizon], other, other + [0.0, 30.0, 0.0]])
     request = mpc.request(
         "support-1", yhat, waypoints, work.path, work.indices, world.sigma0_map().sigma_m,
