@@ -107,3 +107,21 @@ def test_the_study_bench_reports_runs_per_hour_and_the_ray_to_local_ratio(monkey
     assert rows["study_runs_per_hour"].value == pytest.approx(20 / 72.0 * 3600)
     ratio = rows["ray_over_local_wall_ratio"]
     assert ratio.value == pytest.approx(1.05) and ratio.ok
+
+
+def test_the_margins_rows_hold_the_run_with_margins_to_the_target(monkeypatch):
+    from mission.runs import bench_margins
+
+    posed = {}
+    monkeypatch.setattr(
+        bench_margins, "_posed", lambda world, cycles: posed.setdefault(id(world), [world])
+    )
+    ratios = iter([(1.2, 1.3), (1.4, 1.8)])  # the run with margins, then the paper's form
+    monkeypatch.setattr(bench_margins, "_ratios", lambda requests, paper, safe: next(ratios))
+    rows = {r.name: r for r in bench_margins.bench_margins(cycles=3)}
+    assert rows["support_mpc_margins_median_ratio"].ok
+    assert rows["support_mpc_margins_p95_ratio"].ok is False
+    assert rows["support_mpc_margins_p95_ratio_paper_run"].value == 1.8
+    assert rows["support_mpc_margins_median_ratio_paper_run"].ok is None  # a reference
+    margins = [w.scenario.control.min_separation_m for [w] in posed.values()]
+    assert margins == [2.0, 0.0]  # posed with the defaults first, then in the paper's form
