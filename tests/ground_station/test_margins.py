@@ -128,8 +128,8 @@ def test_the_half_spaces_are_those_of_their_definition(structure, write_scenario
         roof.apply_translation([0.0, 0.0, 8.5])
         roof.export(str(tmp_path / "roof.stl"))
         world = World(load_scenario(write_scenario(
-            "world: {structure: {mesh_file: roof.stl, primitives: [{name: post, min_m: [-2, -8, 0], "
-            "max_m: [2, -6, 8]}]}}\n"
+            "world: {structure: {mesh_file: roof.stl, primitives: "
+            "[{name: post, min_m: [-2, -8, 0], max_m: [2, -6, 8]}]}}\n"
         )))  # fmt: skip
     margins = Margins(world.scenario.control, world.structure, others=3)
     assert margins.slots == SLOTS

@@ -8,7 +8,6 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +15,8 @@ import pytest
 import trimesh
 
 from mission.config.scenario import load_scenario
-from mission.world.frames import GeodeticFrame
 from mission.world.model import World
+from tests.margins_check import independent_truth, run_margins
 from tests.processes import mission
 from tests.runs.test_run import _records
 
@@ -77,35 +76,11 @@ def test_a_crash_stops_the_run_as_failed_with_the_reason(crashed):
     assert "Run stopped: support-1 crashed" in ground_station_log
 
 
-def _independent_truth(tlog: Path, scenario) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """Every vehicle's SIM_STATE with its step's SYSTEM_TIME stamp, read by pymavlink."""
-    os.environ.setdefault("MAVLINK20", "1")
-    from pymavlink import mavutil
-
-    frame = GeodeticFrame(scenario.world.anchor)
-    epoch = scenario.run.epoch_unix_s
-    log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega")
-    pending, tracks = {}, {}
-    while (message := log.recv_match(type=["SIM_STATE", "SYSTEM_TIME"])) is not None:
-        source = message.get_srcSystem()
-        if source == 255:
-            continue
-        if message.get_type() == "SIM_STATE":
-            pending[source] = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
-        elif source in pending:
-            t = round(message.time_unix_usec / 1e6 - epoch, 3)
-            tracks.setdefault(source, {})[t] = pending.pop(source)
-    return {
-        s: (np.array(sorted(track)), np.array([track[t] for t in sorted(track)]))
-        for s, track in tracks.items()
-    }
-
-
 def test_the_safety_figures_match_an_independent_reading(crashed):
     crashed, scenario_file = crashed
     scenario = load_scenario(str(scenario_file))
     safety = json.loads((crashed / "summary.json").read_text())["safety"]
-    tracks = _independent_truth(crashed / "gcs.tlog", scenario)
+    tracks = independent_truth(crashed / "gcs.tlog", scenario)
     name = {1: "work", 2: "support-1", 3: "support-2", 4: "support-3"}
     # closest approach at the common samples: never below the summary's (which also looks
     # between samples), and within how far two vehicles can close in half a step
@@ -148,7 +123,7 @@ def test_a_blind_work_uav_holds_where_it_is(tmp_path):
     ]
     assert len(records) >= 15 and all(r["blind"] for r in records)
     scenario = load_scenario(str(path))
-    times, positions = _independent_truth(tmp_path / "run" / "gcs.tlog", scenario)[1]
+    times, positions = independent_truth(tmp_path / "run" / "gcs.tlog", scenario)[1]
     assert len(times) >= 15
     drift = np.linalg.norm(positions - positions[0], axis=1).max()
     assert drift < 1e-3  # tracking noise is 0: not a millimetre
@@ -162,17 +137,8 @@ def test_the_defaults_keep_their_margins_along_the_whole_run(tmp_path):
     every sample."""
     result = mission("run", "along", "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
-    scenario = load_scenario("along")
-    control = scenario.control
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["completed"] and summary["safety"]["contacts"] == []
-    tracks = _independent_truth(tmp_path / "run" / "gcs.tlog", scenario)
-    for a, b in itertools.combinations(sorted(tracks), 2):
-        times = np.intersect1d(tracks[a][0], tracks[b][0])
-        pa = tracks[a][1][np.searchsorted(tracks[a][0], times)]
-        pb = tracks[b][1][np.searchsorted(tracks[b][0], times)]
-        assert np.linalg.norm(pa - pb, axis=1).min() >= control.min_separation_m
-    query = trimesh.proximity.ProximityQuery(World(scenario).structure.mesh)
-    for _, positions in tracks.values():
-        clearance = np.minimum(np.abs(query.signed_distance(positions)), positions[:, 2])
-        assert clearance.min() >= control.clearance_m
+    kept = run_margins(tmp_path / "run", "along")
+    assert (kept.separation_m, kept.clearance_m) == (2.0, 0.5)
+    assert kept.kept, kept
