@@ -89,8 +89,27 @@ def run_margins(run_dir: Path, scenario_file: Path | str | None = None) -> Margi
     )
 
 
+def support_estimate_errors(run_dir: Path) -> np.ndarray:
+    """(n, 3) each support's estimate yhat (records.jsonl) less its truth at the same cycle,
+    over every cycle: what the margins' allowance for an estimate must cover."""
+    import json
+
+    scenario = load_scenario(str(run_dir / "scenario.yaml"))
+    tracks = independent_truth(run_dir / "gcs.tlog", scenario)
+    lines = (run_dir / "records.jsonl").read_text().splitlines()
+    errors = []
+    for record in map(json.loads, lines):
+        for name, yhat in record["yhat"].items():
+            times, positions = tracks[int(name.split("-")[1]) + 1]  # support-n is system n+1
+            at = np.searchsorted(times, record["t"])
+            if at < len(times) and times[at] == record["t"]:
+                errors.append(np.asarray(yhat) - positions[at])
+    return np.array(errors).reshape(-1, 3)
+
+
 def main(argv: list[str]) -> int:
-    """One line per run folder below ``argv[0]``, then the counts."""
+    """One line per run folder below ``argv[0]``, then the counts and the supports' estimate
+    errors."""
     runs = sorted(p.parent for p in Path(argv[0]).glob("**/gcs.tlog"))
     results = {run.name: run_margins(run) for run in runs}
     for name, m in results.items():
@@ -107,6 +126,13 @@ def main(argv: list[str]) -> int:
         f"{touching} touching; least closest approach "
         f"{min(m.closest_approach_m for m in values):.3f} m, "
         f"least clearance {min(m.least_clearance_m for m in values):.3f} m"
+    )
+    errors = np.vstack([support_estimate_errors(run) for run in runs])
+    std, worst = errors.std(axis=0), np.abs(errors).max(axis=0)
+    print(
+        f"support estimates, {len(errors)} cycles: error std x y z {std.round(3).tolist()} m, "
+        f"largest {worst.round(3).tolist()} m, 99.9th percentile of the horizontal "
+        f"{np.percentile(np.abs(errors[:, :2]), 99.9):.3f} m"
     )
     return 0
 
