@@ -25,7 +25,7 @@ import numpy as np
 
 from ground_station.los_anchors import LosAnchors
 from ground_station.margins import Margins
-from ground_station.support_nlp import build_support_nlp
+from ground_station.support_nlp import MARGIN_WEIGHT, build_support_nlp
 from mission.config.resources import mpc_window_shape
 from mission.config.settings import ControlSettings
 from mission.world.camera import CameraModel
@@ -232,22 +232,41 @@ class SupportMpc:
         return yhat + (terminal - yhat) * fractions
 
     def _solve_once(self, fixed: np.ndarray, flags: np.ndarray, guess: np.ndarray):
-        """The minimum over both branches of the terminal xi: (path, status, true cost)."""
+        """The minimum over both branches of the terminal xi: (path, status, true cost).
+
+        Where near cannot keep a margin (one is out of reach from the terminal waypoint), its
+        slacks cost at least ``near_floor``: far is solved first, and near only if far costs
+        more (such a near problem is the one fatrop stalls on: 50 iterations for nothing)."""
         c, horizon = self.control, self.horizon
         yhat, terminal = fixed[:3], self._terminal_of(fixed)
         reach = (horizon + 1) * c.d_max_support_m
-        best = None
+        best = far = None
         if np.linalg.norm(terminal - yhat) <= reach:
+            near_floor = self._near_floor(terminal, flags)
+            if near_floor > 0:
+                far = self._solve_branch(fixed, flags, guess, "far")
+                if far[1] == CONVERGED and far[2] <= near_floor:
+                    return far
             best = self._solve_branch(fixed, flags, guess, "near")
             start = 3 * horizon + horizon + 3  # G's window, after the anchors, flags, corner
             g_min = flags[start : start + self._window_grid.n_voxels].min()
             far_floor = c.w_penalty * c.d_max_support_m**2 + c.w_gnss * horizon * g_min
             if best[1] == CONVERGED and best[2] <= far_floor:
                 return best
-        far = self._solve_branch(fixed, flags, guess, "far")
+        if far is None:
+            far = self._solve_branch(fixed, flags, guess, "far")
         tried = [plan for plan in (best, far) if plan is not None]
         converged = [plan for plan in tried if plan[1] == CONVERGED]
         return min(converged or tried, key=lambda plan: plan[2])
+
+    def _near_floor(self, terminal: np.ndarray, flags: np.ndarray) -> float:
+        """A lower bound of near's cost from its margins' slacks (0 without margins)."""
+        if not self.margins.slots:
+            return 0.0
+        count = self.horizon * self.margins.slots * 4
+        return MARGIN_WEIGHT * self.margins.least_slack(
+            terminal, self.control.d_max_support_m, flags[-count:]
+        )
 
     def _solve_branch(self, fixed, flags, guess, branch: str):
         """One branch's solve from ``guess``: (path, casadi's status, true cost)."""

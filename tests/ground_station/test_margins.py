@@ -145,3 +145,37 @@ def test_the_half_spaces_are_those_of_their_definition(structure, write_scenario
         np.testing.assert_allclose(
             ours, _reference_half_spaces(margins, guess, yhat, others), rtol=0, atol=1e-12
         )
+
+
+def test_near_is_not_solved_where_far_beats_what_its_slacks_must_cost(worlds, monkeypatch):
+    """A terminal waypoint inside another UAV's margin: near would have to break it (fatrop
+    stalls on that problem); far, solved first, costs less than near's slacks at least would,
+    and near is never solved."""
+    safe, _ = worlds
+    mpc = _mpc(safe, 3)
+    plan_ = read_plan(safe.scenario)
+    horizon = safe.scenario.control.horizon_steps
+    yhat = np.array([-6.0, 12.0, 8.5])  # in the open, beside the bridge
+    work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
+    terminal = work.indices[horizon]  # also the target of the later steps
+    waypoints = np.repeat([yhat], 15, axis=0)
+    waypoints[terminal] = yhat + [2.8, 0.0, 0.0]  # where support 2 is parked
+    parked = np.repeat([waypoints[terminal]], horizon, axis=0)
+    others = np.array([work.path[:horizon], parked, parked + [0.0, 30.0, 0.0]])
+    request = mpc.request(
+        "support-1", yhat, waypoints, work.path, work.indices, safe.sigma0_map().sigma_m,
+        others=others,
+    )  # fmt: skip
+    solved = []
+    solve_branch = SupportMpc._solve_branch
+
+    def counted(self, fixed, flags, guess, branch):
+        solved.append(branch)
+        return solve_branch(self, fixed, flags, guess, branch)
+
+    monkeypatch.setattr(SupportMpc, "_solve_branch", counted)
+    kept = mpc.plan(request, safe.camera.observable)
+    assert kept.status == CONVERGED and "near" not in solved and "far" in solved
+    control = safe.scenario.control
+    apart = np.linalg.norm(kept.path - parked, axis=1).min()
+    assert apart >= control.min_separation_m + 2 * control.estimate_allowance_m - 1e-3
