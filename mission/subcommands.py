@@ -252,9 +252,13 @@ def analyze(args: argparse.Namespace) -> int:
     summary_path = tlog.parent / "summary.json"
     previous = _previous_summary(summary_path)
     scenario = _run_scenario(args.run, tlog.parent, previous, args.scenario)
+    plots = tlog.parent / "plots"
+    if args.plots:
+        _check_plots(plots)
     metrics = run_metrics(tlog, scenario)
     if not metrics["control_cycles"]:
         raise InputError(str(tlog), "", "holds no control cycle of a ground station")
+    _check_holds_the_summary(tlog, metrics, previous)
     merged = {**previous, **metrics}
     if previous:
         from mission.procs.atomic import write_text_atomically
@@ -268,7 +272,6 @@ def analyze(args: argparse.Namespace) -> int:
 
         trace = read_tlog(tlog, scenario)
         label = RunLabel(scenario.name, previous.get("method"), previous.get("seed"))
-        plots = tlog.parent / "plots"
         for path in plot_run(trace, World(scenario), tlog.parent / "g", plots, label):
             print(f"wrote {path}")
     return 0
@@ -317,6 +320,32 @@ def view(args: argparse.Namespace) -> int:
     except ViewerFailed as error:
         print(f"view failed: {error}", file=sys.stderr)
         return 1
+
+
+def _check_plots(plots: Path) -> None:
+    """The figures' folder and files can be written (before anything is)."""
+    from mission.analysis.run_plot import FIGURES
+
+    check_output_dir(plots, "--plots")
+    for name in FIGURES:
+        if (plots / name).is_dir():
+            raise InputError("command line", "--plots", f"{plots / name} is a directory")
+
+
+def _check_holds_the_summary(tlog: Path, metrics: dict, previous: dict) -> None:
+    """A tlog with fewer control cycles than its summary records, or without the completion
+    it records, was cut short (a copy interrupted, a full disk): the summary is kept."""
+    cycles, recorded = metrics["control_cycles"], previous.get("control_cycles")
+    lost = isinstance(recorded, int) and cycles < recorded
+    if lost or (previous.get("completed") is True and not metrics.get("completed")):
+        completion = "" if metrics.get("completed") else ", no completion,"
+        raise InputError(
+            str(tlog),
+            "",
+            f"holds {cycles} control cycles{completion} where summary.json records "
+            f"{recorded}{' and a completed run' if previous.get('completed') else ''}: "
+            "cut short? summary.json is not rewritten",
+        )
 
 
 def _previous_summary(path: Path) -> dict:

@@ -29,6 +29,7 @@ from mission.world.model import Sigma0Map, World
 
 COLORS = {1: "tab:red", 2: "tab:blue", 3: "tab:green", 4: "tab:purple", 5: "tab:olive"}
 AXES = "xyz"
+FIGURES = ("trajectories.png", "error.png", "g_update.png")  # what plot_run writes
 
 
 @dataclass(frozen=True)
@@ -57,7 +58,7 @@ def plot_run(
     out_dir.mkdir(parents=True, exist_ok=True)
     sigma0 = world.sigma0_map()
     initial, final = _snapshots(g_dir, sigma0)
-    paths = [out_dir / "trajectories.png", out_dir / "error.png", out_dir / "g_update.png"]
+    paths = [out_dir / name for name in FIGURES]
     _trajectories(trace, world, dataclasses.replace(sigma0, sigma_m=final), paths[0], label)
     _error(trace, world, paths[1], label)
     _g_update(world, sigma0, initial, final, paths[2], label)

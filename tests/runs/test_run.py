@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import signal
 import struct
 import subprocess
@@ -78,6 +79,31 @@ def _run(scenario: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
     )
 
 
+def _analyze(run: Path, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "mission", "analyze", str(run), *extra],
+        capture_output=True, text=True, timeout=300, cwd=ROOT,
+    )  # fmt: skip
+
+
+def _analysis_keeps_a_summary_its_tlog_cannot_hold(run: Path, copy: Path) -> None:
+    """A copy of a finished run whose tlog was cut short, and one whose figures cannot be
+    written: each refused on one line, its summary.json byte for byte as it was."""
+    shutil.copytree(run, copy)
+    summary = (copy / "summary.json").read_bytes()
+    (copy / "plots" / "error.png").unlink()
+    (copy / "plots" / "error.png").mkdir()
+    refused = _analyze(copy, "--plots")
+    assert refused.returncode == 2 and "error.png is a directory" in refused.stderr
+    tlog = (copy / "gcs.tlog").read_bytes()
+    (copy / "gcs.tlog").write_bytes(tlog[: len(tlog) * 2 // 5])
+    refused = _analyze(copy)
+    assert refused.returncode == 2, refused.stderr
+    assert len(refused.stderr.strip().splitlines()) == 1
+    assert "cut short? summary.json is not rewritten" in refused.stderr
+    assert (copy / "summary.json").read_bytes() == summary
+
+
 def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path):
     result = _run(scenario, tmp_path / "a", "--seed", "2", "--mpc-helper")
     assert result.returncode == 0, result.stderr
@@ -112,6 +138,7 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
         assert struct.unpack(">II", header[16:24]) == size
     assert metrics == {k: summary[k] for k in metrics}, "the tlog alone gives the same metrics"
     assert summary["scenario_source"] == str(scenario)
+    _analysis_keeps_a_summary_its_tlog_cannot_hold(tmp_path / "a", tmp_path / "cut")
 
     # The same seed again, with every link signed, every MPC solved in the ground station (no
     # helper process), and the station and each vehicle started as `python -m ...` instead of
