@@ -94,9 +94,10 @@ def _check_scenarios(spec) -> dict[str, str]:
 
 def _engine(args: argparse.Namespace):
     if args.engine == "ray":
-        from mission.studies.ray_engine import RayEngine, require_ray
+        from mission.studies.ray_engine import RayEngine, check_reachable, require_ray
 
         require_ray()
+        check_reachable(args.address, "--address" if args.address else "RAY_ADDRESS")
         return RayEngine(args.address, args.jobs)
     if args.address is not None:
         raise InputError("command line", "--address", "is for --engine ray")

@@ -378,6 +378,16 @@ CASES = [
         lambda t: ["study", str(_study(t)), "--address", "10.0.0.1:6379"],
         ["--address", "--engine ray"],
     ),
+    (
+        "study-ray-unreachable",  # Ray retries for minutes: refused before anything starts
+        lambda t: ["study", str(_study(t)), "--engine", "ray", "--address", "127.0.0.1:1"],
+        ["--address", "no Ray head answers at 127.0.0.1:1"],
+    ),
+    (
+        "study-ray-address-form",
+        lambda t: ["study", str(_study(t)), "--engine", "ray", "--address", "headnode"],
+        ["--address", "is not HOST:PORT"],
+    ),
     ("study-keep", lambda t: ["study", str(_study(t)), "--keep", "some"], ["--keep"]),
     (
         "study-out-is-file",

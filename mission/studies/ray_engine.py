@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import socket
 import tempfile
 import time
 from dataclasses import dataclass
@@ -26,6 +27,26 @@ from mission.studies.runkeys import StudyRun
 INSTALL_HINT = "the Ray engine needs Ray: pip install -e '.[ray]' (or pip install 'ray>=2.9')"
 CORES_PER_RUN = 1  # the ground station's core; the vehicles sleep most of a step
 WAIT_S = 0.5
+REACH_S = 10.0  # how long a cluster's head may take to accept a connection
+
+
+def check_reachable(address: str | None, flag: str = "--address") -> None:
+    """A cluster address (``--address``, else ``RAY_ADDRESS``) whose head answers on its port
+    within REACH_S; Ray itself retries an unreachable head for minutes. ``auto`` and Ray
+    Client addresses (``ray://``) are left to Ray."""
+    address = address or os.environ.get("RAY_ADDRESS")
+    if not address or address == "auto" or address.startswith("ray://"):
+        return
+    where = "command line" if flag == "--address" else "environment"
+    host, _, port = address.rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InputError(where, flag, f"{address!r} is not HOST:PORT")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=REACH_S).close()
+    except OSError as error:
+        raise InputError(
+            where, flag, f"no Ray head answers at {address} ({error.strerror or error})"
+        ) from None
 
 
 def require_ray() -> Any:
