@@ -62,6 +62,10 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
     check_output_dir(out, "--out")
     if args.runs is not None:
         check_output_dir(args.runs, "--runs")
+    repeated = [s for i, s in enumerate(spec.scenarios) if s in spec.scenarios[:i]]
+    if repeated:
+        field = "SCENARIO" if spec.source == Path("command line") else "scenarios"
+        raise InputError(str(spec.source), field, f"lists {repeated[0]} twice")
     names = _check_scenarios(spec)
     if len(set(names.values())) != len(names):
         raise InputError(str(spec.source), "scenarios", "two scenarios have the same name")

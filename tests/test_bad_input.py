@@ -389,6 +389,12 @@ CASES = [
         ["--address", "is not HOST:PORT"],
     ),
     ("study-keep", lambda t: ["study", str(_study(t)), "--keep", "some"], ["--keep"]),
+    ("batch-twice", lambda t: ["batch", "along", "along", "--trials", "1"], ["along twice"]),
+    (
+        "study-scenario-twice",
+        lambda t: ["study", str(_raw(t, "scenarios: [wall, along, wall]\nseeds: 1\n"))],
+        ["raw.yaml: scenarios: lists wall twice"],
+    ),
     (
         "study-out-is-file",
         lambda t: ["study", str(_study(t)), "--out", str(_file(t))],
