@@ -30,6 +30,11 @@ class LocalEngine:
     jobs: int
 
     @property
+    def cores(self) -> int:
+        """How many runs go at once."""
+        return self.jobs
+
+    @property
     def description(self) -> str:
         """What the progress line says of the engine."""
         return f"local engine, {self.jobs} at a time"

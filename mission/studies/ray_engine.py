@@ -67,6 +67,14 @@ class RayEngine:
     jobs: int | None
 
     @property
+    def cores(self) -> int | None:
+        """How many runs go at once: ``jobs``; this machine's cores for a Ray started here;
+        None (as many as it has cores) on a cluster."""
+        if self.jobs:
+            return self.jobs
+        return None if self.address or os.environ.get("RAY_ADDRESS") else os.cpu_count()
+
+    @property
     def description(self) -> str:
         """What the progress line says of the engine."""
         where = f"cluster at {self.address}" if self.address else "a local Ray"

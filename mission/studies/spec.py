@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -199,6 +200,11 @@ def scenario_reference(
 def _seeds(source: str, value: Any) -> tuple[int, ...]:
     if isinstance(value, bool):
         raise InputError(source, "seeds", "must be a count, a list or {start, count}")
+    count = value if isinstance(value, int) else None
+    if isinstance(value, dict) and isinstance(value.get("count"), int):
+        count = value["count"]
+    if count is not None and count > MAX_RUNS:  # before a list of them is made
+        raise InputError(source, "seeds", f"{count} seeds; at most {MAX_RUNS} runs in one study")
     if isinstance(value, int):
         seeds = list(range(value))
     elif isinstance(value, list):
@@ -239,6 +245,9 @@ def _points(source: str, grid: Any, points: Any) -> tuple[Point, ...]:
         clash = sorted(set(map(str, point)) & set(map(str, grid)))
         if clash:
             raise InputError(source, f"points[{number}].{clash[0]}", "is also a grid key")
+    size = len(points) * math.prod(len(values) for values in grid.values())
+    if size > MAX_RUNS:  # before the grid is expanded
+        raise InputError(source, "grid", f"{size} points; at most {MAX_RUNS} runs in one study")
     combos = list(itertools.product(*grid.values()))
     expanded = [
         Point(tuple((str(k), v) for k, v in point.items()) + tuple(zip(map(str, grid), combo)))

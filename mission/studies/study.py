@@ -24,12 +24,19 @@ from mission.studies.spec import StudySpec, validate_points
 from mission.studies.table3 import write_tables
 
 REPORT_EVERY_S = 60.0  # the report and its figures, while runs finish (and at the end)
+RUN_CPU_S = 7.0  # CPU-seconds of a run's processes (docs/benchmarks.md), at REFERENCE_LOOP_S
+REFERENCE_LOOP_S = 0.146  # the machine those were measured on (`machine_python_loop_s`)
+WARN_AFTER_S = 3600.0  # a study expected to take longer is announced with its estimate
 
 
 class Engine(Protocol):
     """Runs a list of study runs, reporting each as it finishes."""
 
     description: str
+
+    @property
+    def cores(self) -> int | None:
+        """How many runs go at once (None: as many as a cluster has cores)."""
 
     def run(self, runs: list[StudyRun], runs_dir: Path, keep: Keep, done: Done) -> None:
         """Run them all; stop what is running on any exit."""
@@ -75,6 +82,9 @@ def run_study(
     pending = [run for run in runs if run not in summaries]
     failed: list[str] = []
     bar = ProgressBar(len(runs), len(summaries), progress, engine.description)
+    note = duration_note(len(pending), engine.cores)
+    if note:
+        progress.write(note + "\n")
     start = last_report = time.monotonic()
 
     def done(run: StudyRun, summary: dict | None, wall: float) -> None:
@@ -132,6 +142,31 @@ def _one_line(summary: dict[str, Any]) -> str:
         f"{done}, {summary['multipath_steps_total']} steps in multipath, "
         f"wall {summary['wall_time_s']:.1f} s"
     )
+
+
+def duration_note(runs: int, cores: int | None) -> str | None:
+    """What a study of ``runs`` will take, said before it starts when that is over an hour
+    (at this machine's speed, from the benchmarks' cost of a run); None when it is not."""
+    per_core = runs * RUN_CPU_S
+    if per_core / (cores or 1) < WARN_AFTER_S / 4:  # surely under an hour: no measuring
+        return None
+    from mission.runs.bench import bench_machine_speed
+
+    per_core *= bench_machine_speed(repeats=1).value / REFERENCE_LOOP_S
+    wall = per_core / (cores or 1)
+    if wall < WARN_AFTER_S:
+        return None
+    where = f"on {cores} cores" if cores else "per core of the cluster"
+    return (
+        f"study: {runs} runs to go, about {_span(wall)} {where} "
+        f"({RUN_CPU_S:g} CPU-seconds a run on this machine: `mission bench --only run`)"
+    )
+
+
+def _span(seconds: float) -> str:
+    """1.5 h, 3.2 days."""
+    hours = seconds / 3600
+    return f"{hours:.1f} h" if hours < 48 else f"{hours / 24:.1f} days"
 
 
 class ProgressBar:

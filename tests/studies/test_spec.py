@@ -61,6 +61,7 @@ def test_every_shipped_study_is_valid():
             assert len(spec.seeds) >= 15 and set(spec.methods) == {"ac", "nac"}
 
 
+GRID_WEIGHTS = ("gnss", "interval", "waypoint", "relative", "penalty")
 BAD = [
     ("scenarios: [along]\nsedes: 3\n", "sedes: unknown key"),
     ("scenarios: [along]\nrealtime: 0\n", "realtime: must be in (0, 1000], got 0"),
@@ -102,6 +103,22 @@ BAD = [
         "tables: Table 3 is for a study of one point",
     ),
     ("name: ../up\nscenarios: [along]\n", "name: must be a plain folder name"),
+    (  # refused before a list of 10^12 seeds is made (11.7 GB and a MemoryError before)
+        "scenarios: [along]\nseeds: 1000000000000\n",
+        "seeds: 1000000000000 seeds; at most 1000000 runs in one study",
+    ),
+    (
+        "scenarios: [along]\nseeds: {start: 5, count: 2000000}\n",
+        "seeds: 2000000 seeds; at most 1000000",
+    ),
+    (  # and before a grid of 10^8 points is expanded
+        "scenarios: [along]\ngrid: {"
+        + ", ".join(f"control.w_{w}: {list(range(1, 11))}" for w in GRID_WEIGHTS)
+        + ", map.eta: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95]"
+        + ", fusion.broad_sigma_m: [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4]"
+        + ", fusion.rho_threshold: [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]}\n",
+        "grid: 100000000 points; at most 1000000 runs in one study",
+    ),
     ("[1, 2]\n", "the file must hold a mapping"),
 ]
 
@@ -119,3 +136,23 @@ def test_a_bad_study_file_is_one_line_naming_the_file_and_the_culprit(tmp_path, 
 def test_a_missing_study_file_is_named(tmp_path):
     with pytest.raises(InputError, match="no such study file"):
         load_study(tmp_path / "nope.yaml")
+
+
+def test_a_study_over_an_hour_is_announced_with_its_estimate(monkeypatch):
+    import mission.runs.bench
+    from mission.runs.bench_result import BenchResult
+    from mission.studies.study import REFERENCE_LOOP_S, duration_note
+
+    def reference_speed(repeats: int = 5) -> BenchResult:
+        return BenchResult("machine_python_loop_s", REFERENCE_LOOP_S, "s", "reference", None)
+
+    def unmeasured(repeats: int = 5) -> BenchResult:
+        raise AssertionError("a small study measures nothing")
+
+    monkeypatch.setattr(mission.runs.bench, "bench_machine_speed", unmeasured)
+    assert duration_note(60, 2) is None  # Table 3: minutes
+    monkeypatch.setattr(mission.runs.bench, "bench_machine_speed", reference_speed)
+    assert duration_note(1000, 2) is None  # 3,500 s: just under the hour
+    note = duration_note(1_000_000, 2)  # 7 CPU-s a run on 2 cores: 3.5e6 s
+    assert note is not None and "about 40.5 days on 2 cores" in note
+    assert "per core of the cluster" in duration_note(2000, None)
