@@ -65,10 +65,17 @@ def check_seed(seed: int, flag: str = "--seed") -> None:
         raise InputError("command line", flag, f"must not be negative, got {seed}")
 
 
+# Real time from a tenth of wall speed (slower, and a vehicle's 1 Hz heartbeat takes longer
+# than the ground station's connection wait) to a thousand times it.
+MIN_SPEEDUP, MAX_SPEEDUP = 0.1, 1000.0
+
+
 def check_speedup(speedup: float, flag: str = "--speedup") -> None:
-    """A real-time speed-up in (0, 1000]."""
-    if not 0 < speedup <= 1000:
-        raise InputError("command line", flag, f"must be in (0, 1000], got {speedup:g}")
+    """A real-time speed-up in [MIN_SPEEDUP, MAX_SPEEDUP]."""
+    if not MIN_SPEEDUP <= speedup <= MAX_SPEEDUP:
+        raise InputError(
+            "command line", flag, f"must be in [{MIN_SPEEDUP:g}, {MAX_SPEEDUP:g}], got {speedup:g}"
+        )
 
 
 def check_port(port: int, flag: str, allow_any: bool = False) -> None:

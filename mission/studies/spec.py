@@ -32,6 +32,7 @@ from typing import Any
 from mission.config.errors import InputError, ScenarioError
 from mission.config.scenario import load_scenario, read_yaml_mapping, resolve_scenario_path
 from mission.config.settings import Scenario
+from mission.procs.cli_common import MAX_SPEEDUP, MIN_SPEEDUP
 
 METHODS = ("ac", "nac")
 TABLES = ("table3",)
@@ -46,7 +47,6 @@ _KEYS = {
     "tables",
     "realtime",
 }
-MAX_SPEEDUP = 1000.0
 MAX_RUNS = 1_000_000
 
 
@@ -95,13 +95,14 @@ class StudySpec:
 
 
 def _speedup(source: str, value: Any) -> float | None:
-    """``realtime``: a speed-up in (0, 1000], or absent (lockstep)."""
+    """``realtime``: a speed-up in [MIN_SPEEDUP, MAX_SPEEDUP], or absent (lockstep)."""
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(source, "realtime", f"must be a speed-up (a number), got {value!r}")
-    if not 0 < value <= MAX_SPEEDUP:
-        raise InputError(source, "realtime", f"must be in (0, {MAX_SPEEDUP:g}], got {value:g}")
+    if not MIN_SPEEDUP <= value <= MAX_SPEEDUP:
+        span = f"[{MIN_SPEEDUP:g}, {MAX_SPEEDUP:g}]"
+        raise InputError(source, "realtime", f"must be in {span}, got {value:g}")
     return float(value)
 
 

@@ -64,7 +64,8 @@ def test_every_shipped_study_is_valid():
 GRID_WEIGHTS = ("gnss", "interval", "waypoint", "relative", "penalty")
 BAD = [
     ("scenarios: [along]\nsedes: 3\n", "sedes: unknown key"),
-    ("scenarios: [along]\nrealtime: 0\n", "realtime: must be in (0, 1000], got 0"),
+    ("scenarios: [along]\nrealtime: 0\n", "realtime: must be in [0.1, 1000], got 0"),
+    ("scenarios: [along]\nrealtime: 0.001\n", "realtime: must be in [0.1, 1000], got 0.001"),
     ("scenarios: [along]\nrealtime: true\n", "realtime: must be a speed-up (a number)"),
     ("scenarios: [along]\nrealtime: fast\n", "realtime: must be a speed-up (a number)"),
     ("seeds: 3\n", "scenarios: must be a non-empty list"),
