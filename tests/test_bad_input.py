@@ -299,6 +299,7 @@ CASES = [
     ("run-seed", lambda t: [*RUN, "--seed", "-1"], ["--seed", "negative"]),
     ("run-speedup-lockstep", lambda t: [*RUN, "--speedup", "0"], ["--speedup", "--realtime"]),
     ("run-speedup-high", lambda t: [*RUN, "--realtime", "--speedup", "5000"], ["--speedup"]),
+    ("run-observer-host", lambda t: [*RUN, "--observer", "999.1.1.1:14550"], ["'999.1.1.1'"]),
     ("run-speedup-tiny", lambda t: [*RUN, "--realtime", "--speedup", "1e-9"], ["[0.1, 1000]"]),
     ("gcs-seed", lambda t: ["--seed", "-3"], ["--seed", "negative"]),
     ("gcs-base-port", lambda t: ["--base-port", "70000"], ["--base-port", "65535"]),

@@ -236,10 +236,15 @@ def pack_datagrams(packets: Sequence[bytes]) -> list[bytes]:
 
 
 def parse_address(text: str, what: str = "address") -> Address:
-    """'HOST:PORT' -> (host, port); ValueError with a clear message otherwise."""
+    """'HOST:PORT' -> (host, port), the host an IPv4 address or a name that resolves to one
+    (the links are IPv4 UDP); ValueError with a clear message otherwise."""
     host, sep, port_text = text.rpartition(":")
     if not sep or not host or not port_text.isdigit() or not 0 < int(port_text) < 65536:
         raise ValueError(f"{what} must look like HOST:PORT, got {text!r}")
+    try:
+        socket.getaddrinfo(host, int(port_text), socket.AF_INET, socket.SOCK_DGRAM)
+    except (socket.gaierror, UnicodeError):
+        raise ValueError(f"{text!r}: {host!r} is not an IPv4 address or a known host") from None
     return host, int(port_text)
 
 
