@@ -136,7 +136,7 @@ def _add_run_parser(commands) -> None:
     )
     run.add_argument("--realtime", action="store_true", help="real time instead of lockstep")
     run.add_argument(
-        "--speedup", type=float, help="with --realtime: this many times faster, 0.1-1000 (default 1)"
+        "--speedup", type=float, help="with --realtime: times faster, 0.1-1000 (default 1)"
     )
     run.add_argument(
         "--signing-key", type=Path, metavar="FILE", help="sign every link (32-byte secret)"
@@ -195,7 +195,7 @@ def _add_batch_parser(commands) -> None:
         "--realtime", action="store_true", help="every run in real time instead of lockstep"
     )
     batch.add_argument(
-        "--speedup", type=float, help="with --realtime: this many times faster, 0.1-1000 (default 1)"
+        "--speedup", type=float, help="with --realtime: times faster, 0.1-1000 (default 1)"
     )
 
 
