@@ -30,6 +30,13 @@ def world(args: argparse.Namespace) -> int:
     if point is not None:
         from mission.analysis.world_report import point_report
 
+        space = world.scenario.world.workspace
+        if not all(low <= v <= high for v, low, high in zip(point, space.min_m, space.max_m)):
+            where = f"{list(space.min_m)}..{list(space.max_m)}"
+            raise InputError(
+                "command line", "--at", f"{list(point)} is outside the workspace {where}"
+            )
+
         print(json.dumps(point_report(world, np.array(point))))
     else:
         from mission.analysis.world_report import summary_text

@@ -299,6 +299,11 @@ CASES = [
     ("run-seed", lambda t: [*RUN, "--seed", "-1"], ["--seed", "negative"]),
     ("run-speedup-lockstep", lambda t: [*RUN, "--speedup", "0"], ["--speedup", "--realtime"]),
     ("run-speedup-high", lambda t: [*RUN, "--realtime", "--speedup", "5000"], ["--speedup"]),
+    (
+        "world-at-far",
+        lambda t: ["world", "along", "--at", "1e300", "0", "0"],
+        ["outside the workspace"],
+    ),
     ("run-observer-host", lambda t: [*RUN, "--observer", "999.1.1.1:14550"], ["'999.1.1.1'"]),
     ("run-speedup-tiny", lambda t: [*RUN, "--realtime", "--speedup", "1e-9"], ["[0.1, 1000]"]),
     ("gcs-seed", lambda t: ["--seed", "-3"], ["--seed", "negative"]),
