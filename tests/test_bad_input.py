@@ -48,6 +48,9 @@ FAR_BOX = (
 WIDE_WINDOW = "map: {voxel_size_m: 0.5}\ncontrol: {horizon_steps: 25}\n"
 HUGE_WORKSPACE = "world: {workspace: {min_m: [-20000, -20000, 0], max_m: [20000, 20000, 100]}}\n"
 RAISED_LIMIT = "map: {voxel_size_m: 0.01}\nlimits: {max_map_voxels: 100000000000}\n"
+MANY_PARTICLES = (
+    "fusion: {broad_particles: 1000000000000}\nlimits: {max_particles: 10000000000000}\n"
+)
 TWO_ZONES = (
     "world: {{zones: [{{name: {name}, min_m: [0, 0, 1], max_m: [1, 1, 2], offset_m: [1, 0, 0]}},"
     " {{name: {name}, min_m: [2, 0, 1], max_m: [3, 1, 2], offset_m: [1, 0, 0]}}]}}\n"
@@ -189,6 +192,11 @@ CASES = [
         "yaml-memory",
         lambda t: [*RUN, str(_scenario(t, RAISED_LIMIT))],
         ["map.voxel_size_m", "limits.max_memory_fraction", "this machine"],
+    ),
+    (
+        "yaml-particle-memory",
+        lambda t: [*RUN, str(_scenario(t, MANY_PARTICLES))],
+        ["fusion.broad_particles", "limits.max_memory_fraction", "this machine"],
     ),
     (
         "mesh-far-away",

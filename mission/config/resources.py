@@ -12,6 +12,9 @@ from mission.config.errors import FieldProblem
 from mission.config.settings import ControlSettings, Scenario
 
 MAP_BYTES_PER_VOXEL = 96  # G, its initial copy, sigma_0, the build's visibility and geometry
+# a cycle's particles: positions, their draws, every support's density and the correlation's
+# copies (112.5 bytes measured at the peak of a fusion with three supports)
+PARTICLE_BYTES, PARTICLE_BYTES_PER_SUPPORT = 48, 24
 
 
 def check_resources(scenario: Scenario) -> None:
@@ -53,6 +56,15 @@ def _check_cycle_work(scenario: Scenario) -> None:
             "fusion.broad_particles",
             f"{particles:,} particles a cycle (broad + local x supports); "
             f"limits.max_particles is {limits.max_particles:,}",
+        )
+    memory = _physical_memory()
+    need = particles * (PARTICLE_BYTES + PARTICLE_BYTES_PER_SUPPORT * scenario.task.supports)
+    if memory is not None and need > limits.max_memory_fraction * memory:
+        raise FieldProblem(
+            "fusion.broad_particles",
+            f"{particles:,} particles a cycle need ~{_gb(need)}, more than "
+            f"limits.max_memory_fraction ({limits.max_memory_fraction:g}) of this machine's "
+            f"{_gb(memory)}",
         )
     if control.horizon_steps > limits.max_horizon_steps:
         raise FieldProblem(
