@@ -316,8 +316,13 @@ def view(args: argparse.Namespace) -> int:
         check_output_file(args.save, "--save", (".rrd",))
     previous = _previous_summary(run_dir / "summary.json")
     scenario = _run_scenario(run_dir, run_dir, previous, args.scenario)
+    from mission.config.resources import map_shape
+    from mission.viewer.check import check_run_files
     from mission.viewer.process import ViewerFailed
     from mission.viewer.replay import replay_run, viewer_kind
+
+    for warning in check_run_files(run_dir, map_shape(scenario), previous):
+        print(f"warning: {warning}", file=sys.stderr)
 
     viewer = viewer_kind(args.web) if args.web or args.save is None else None
     if viewer == "web" and not args.web:
