@@ -62,6 +62,7 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
     check_output_dir(out, "--out")
     if args.runs is not None:
         check_output_dir(args.runs, "--runs")
+    _check_study_outputs(out, args.runs)
     repeated = [s for i, s in enumerate(spec.scenarios) if s in spec.scenarios[:i]]
     if repeated:
         field = "SCENARIO" if spec.source == Path("command line") else "scenarios"
@@ -84,6 +85,22 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
         f"results in {out / 'results.csv'}, report in {out / 'report.md'}"
     )
     return 1 if outcome.failed else 0
+
+
+STUDY_FILES = ("results.csv", "report.md", "table.md", "table.csv", "boxplots.png")
+STUDY_FOLDERS = ("figures", "runs")
+
+
+def _check_study_outputs(out: Path, runs: Path | None) -> None:
+    """What a study writes into ``out`` is not already there as the wrong kind of thing."""
+    for name in STUDY_FILES:
+        if (out / name).is_dir():
+            raise InputError("command line", "--out", f"{out / name} is a directory")
+    for name in STUDY_FOLDERS:
+        if name == "runs" and runs is not None:
+            continue
+        if (out / name).exists() and not (out / name).is_dir():
+            raise InputError("command line", "--out", f"{out / name} is a file, not a directory")
 
 
 def _check_scenarios(spec) -> dict[str, str]:

@@ -1,9 +1,13 @@
 """Output locations checked before anything is started or written: a directory a run may
-create, or a file it may write, named by a flag. Nothing here creates anything."""
+create, or a file it may write, named by a flag. Permission bits do not say everything (root
+may "write" under /proc, where nothing can be made; a read-only mount): the directory that
+will hold the output is probed by making and removing an empty scratch folder in it, and
+nothing else is created."""
 
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 from mission.config.errors import InputError
@@ -30,8 +34,17 @@ def check_output_file(path: Path, flag: str, suffixes: tuple[str, ...] = ()) -> 
     parent = path.parent
     if not parent.is_dir():
         raise InputError("command line", flag, f"{str(path)!r}: no directory {str(parent)!r}")
-    if not os.access(parent, os.W_OK | os.X_OK):
+    if not os.access(parent, os.W_OK | os.X_OK) or not _can_make_in(parent):
         raise InputError("command line", flag, f"{str(path)!r}: cannot write in {str(parent)!r}")
+
+
+def _can_make_in(directory: Path) -> bool:
+    """Whether a folder can really be made (and removed) in ``directory``."""
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".probe-", dir=directory))
+    except OSError:
+        return False
+    return True
 
 
 def _check_writable_ancestor(path: Path, flag: str) -> None:
@@ -44,5 +57,5 @@ def _check_writable_ancestor(path: Path, flag: str) -> None:
         raise InputError(
             "command line", flag, f"{str(path)!r} lies under the file {str(ancestor)!r}"
         )
-    if not os.access(ancestor, os.W_OK | os.X_OK):
+    if not os.access(ancestor, os.W_OK | os.X_OK) or not _can_make_in(ancestor):
         raise InputError("command line", flag, f"{str(path)!r}: cannot write in {str(ancestor)!r}")

@@ -1,0 +1,1 @@
+"""The bad-input table: its cases (files, then commands) and what builds them."""

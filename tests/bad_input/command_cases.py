@@ -1,0 +1,210 @@
+"""Bad command lines: arguments, output locations, numbers out of range, analyze, study, view
+and signing keys (id, argv builder, texts the one error line must hold)."""
+
+from __future__ import annotations
+
+from tests.bad_input.builders import (
+    RUN,
+    SHIPPED_PLAN,
+    busy_port,
+    key_file,
+    new_dir,
+    plain_file,
+    raw_file,
+    study_file,
+    tlog_run,
+)
+
+COMMAND_CASES = [
+    # --- command-line arguments --------------------------------------------------------
+    ("run-method", lambda t: [*RUN, "--method", "best"], ["--method"]),
+    ("run-speedup", lambda t: [*RUN, "--realtime", "--speedup", "0"], ["--speedup"]),
+    ("run-link-loss", lambda t: [*RUN, "--link-loss", "1.5"], ["--link-loss"]),
+    ("run-link-delay", lambda t: [*RUN, "--link-delay-ms", "-3"], ["--link-delay-ms"]),
+    ("run-observer", lambda t: [*RUN, "--observer", "qgc"], ["--observer"]),
+    ("batch-trials", lambda t: ["batch", "--trials", "0"], ["--trials"]),
+    ("batch-jobs", lambda t: ["batch", "--jobs", "0"], ["--jobs"]),
+    ("batch-speedup-alone", lambda t: ["batch", "--speedup", "10"], ["--speedup", "--realtime"]),
+    ("batch-speedup-zero", lambda t: ["batch", "--realtime", "--speedup", "0"], ["--speedup"]),
+    ("gcs-waypoints-dir", lambda t: ["--waypoints", str(t / "none")], ["--waypoints"]),
+    ("analyze-no-tlog", lambda t: ["analyze", str(new_dir(t, "empty"))], ["no gcs.tlog"]),
+    ("batch-methods", lambda t: ["batch", "--methods", "ac,best"], ["--methods"]),
+    ("world-at-nan", lambda t: ["world", "--at", "1", "2", "nan"], ["--at"]),
+    ("world-plot-suffix", lambda t: ["world", "--plot", str(t / "out" / "w.jpg")], ["--plot"]),
+    ("scenario-name", lambda t: [*RUN, "nowhere-scenario"], ["nowhere-scenario"]),
+    ("gcs-vehicles", lambda t: ["--vehicles", "work=localhost"], ["--vehicles"]),
+    ("vehicle-name", lambda t: ["--vehicle", "support-x"], ["support-x"]),
+    ("vehicle-speedup", lambda t: ["--vehicle", "work", "--speedup", "-1"], ["--speedup"]),
+    ("vehicle-socket-fd", lambda t: ["--vehicle", "work", "--socket-fd", "987"], ["--socket-fd"]),
+    (
+        "vehicle-socket-fd-port",
+        lambda t: ["--vehicle", "work", "--socket-fd", "3", "--port", "14560"],
+        ["--socket-fd", "--port"],
+    ),
+    # --- output locations ----------------------------------------------------------------
+    ("run-out-is-file", lambda t: [*RUN, "--out", str(plain_file(t))], ["--out", "is a file"]),
+    ("run-out-under-file", lambda t: [*RUN, "--out", str(plain_file(t) / "a")], ["--out", "under"]),
+    ("run-out-unwritable", lambda t: [*RUN, "--out", "/proc/1/run"], ["--out", "cannot write"]),
+    ("batch-out-is-file", lambda t: ["batch", "--out", str(plain_file(t))], ["--out", "is a file"]),
+    ("plan-out-is-file", lambda t: ["plan", "--out", str(plain_file(t))], ["--out", "is a file"]),
+    ("plan-out-package", lambda t: ["plan", "--out", str(SHIPPED_PLAN)], ["--out", "package"]),
+    ("plan-plot-no-dir", lambda t: ["plan", "--plot", str(t / "x" / "p.png")], ["--plot"]),
+    ("world-plot-is-dir", lambda t: ["world", "--plot", str(new_dir(t, "w.png"))], ["--plot"]),
+    ("gcs-out-is-file", lambda t: ["--out", str(plain_file(t))], ["--out", "is a file"]),
+    ("gcs-tlog-no-dir", lambda t: ["--tlog", str(t / "x" / "g.tlog")], ["--tlog", "no directory"]),
+    # --- numbers out of range ------------------------------------------------------------
+    ("run-seed", lambda t: [*RUN, "--seed", "-1"], ["--seed", "negative"]),
+    ("run-speedup-lockstep", lambda t: [*RUN, "--speedup", "0"], ["--speedup", "--realtime"]),
+    ("run-speedup-high", lambda t: [*RUN, "--realtime", "--speedup", "5000"], ["--speedup"]),
+    (
+        "world-at-far",
+        lambda t: ["world", "along", "--at", "1e300", "0", "0"],
+        ["outside the workspace"],
+    ),
+    ("run-observer-host", lambda t: [*RUN, "--observer", "999.1.1.1:14550"], ["'999.1.1.1'"]),
+    ("run-speedup-tiny", lambda t: [*RUN, "--realtime", "--speedup", "1e-9"], ["[0.1, 1000]"]),
+    ("gcs-seed", lambda t: ["--seed", "-3"], ["--seed", "negative"]),
+    ("gcs-base-port", lambda t: ["--base-port", "70000"], ["--base-port", "65535"]),
+    ("gcs-base-port-top", lambda t: ["--base-port", "65534"], ["--base-port", "65537"]),
+    ("vehicle-seed", lambda t: ["--vehicle", "work", "--seed", "-1"], ["--seed"]),
+    (
+        "vehicle-home-inside",
+        lambda t: ["--vehicle", "work", "--home", "0", "0", "8.5"],
+        ["--home", "inside the structure"],
+    ),
+    (
+        "vehicle-home-outside",
+        lambda t: ["--vehicle", "work", "--home", "0", "0", "50"],
+        ["--home", "outside the workspace"],
+    ),
+    # --- the flag at fault named ---------------------------------------------------------
+    (
+        "vehicle-host-unknown",
+        lambda t: ["--vehicle", "support-1", "--port", "0", "--host", "nosuchhost.invalid"],
+        ["--host"],
+    ),
+    (
+        "vehicle-host-not-ours",
+        lambda t: ["--vehicle", "support-1", "--port", "0", "--host", "192.0.2.1"],
+        ["--host", "not this machine"],
+    ),
+    (
+        "vehicle-port-busy",
+        lambda t: ["--vehicle", "support-1", "--port", str(busy_port())],
+        ["--port", "cannot listen"],
+    ),
+    (
+        "vehicle-truth-port-busy",
+        lambda t: ["--vehicle", "support-1", "--port", "0", "--truth-port", str(busy_port())],
+        ["--truth-port", "cannot listen"],
+    ),
+    # --- mission analyze ---------------------------------------------------------------------
+    (
+        "analyze-empty-tlog",
+        lambda t: ["analyze", str(tlog_run(t, b"")), "--scenario", "along"],
+        ["gcs.tlog", "empty"],
+    ),
+    (
+        "analyze-random-tlog",
+        lambda t: ["analyze", str(tlog_run(t, bytes(range(256)) * 40)), "--scenario", "along"],
+        ["gcs.tlog", "no control cycle"],
+    ),
+    (
+        "analyze-bad-summary",
+        lambda t: ["analyze", str(tlog_run(t, b"x", summary="{not json"))],
+        ["summary.json", "JSON"],
+    ),
+    (
+        "analyze-summary-list",
+        lambda t: ["analyze", str(tlog_run(t, b"x", summary="[1, 2]"))],
+        ["summary.json", "not a JSON object"],
+    ),
+    # --- mission study -------------------------------------------------------------------
+    ("study-missing", lambda t: ["study", str(t / "none.yaml")], ["none.yaml", "no such study"]),
+    (
+        "study-unknown-key",
+        lambda t: ["study", str(study_file(t, "points: [{fusion.rho_thresold: 0.5}]\n"))],
+        ["s.yaml", "fusion.rho_thresold", "unknown key"],
+    ),
+    (
+        "study-bad-value",
+        lambda t: ["study", str(study_file(t, "grid: {map.eta: [0.3, 1.5]}\n"))],
+        ["s.yaml", "point 1", "map.eta"],
+    ),
+    (
+        "study-bad-plan",
+        lambda t: ["study", str(study_file(t, f"points: [{{task.waypoints_dir: {t}}}]\n"))],
+        ["work.waypoints"],
+    ),
+    ("study-jobs", lambda t: ["study", str(study_file(t)), "--jobs", "0"], ["--jobs"]),
+    (
+        "study-address-local",
+        lambda t: ["study", str(study_file(t)), "--address", "10.0.0.1:6379"],
+        ["--address", "--engine ray"],
+    ),
+    (
+        "study-ray-unreachable",  # Ray retries for minutes: refused before anything starts
+        lambda t: ["study", str(study_file(t)), "--engine", "ray", "--address", "127.0.0.1:1"],
+        ["--address", "no Ray head answers at 127.0.0.1:1"],
+    ),
+    (
+        "study-ray-address-form",
+        lambda t: ["study", str(study_file(t)), "--engine", "ray", "--address", "headnode"],
+        ["--address", "is not HOST:PORT"],
+    ),
+    ("study-keep", lambda t: ["study", str(study_file(t)), "--keep", "some"], ["--keep"]),
+    ("batch-twice", lambda t: ["batch", "along", "along", "--trials", "1"], ["along twice"]),
+    (
+        "study-scenario-twice",
+        lambda t: ["study", str(raw_file(t, "scenarios: [wall, along, wall]\nseeds: 1\n"))],
+        ["raw.yaml: scenarios: lists wall twice"],
+    ),
+    (
+        "study-out-is-file",
+        lambda t: ["study", str(study_file(t)), "--out", str(plain_file(t))],
+        ["--out", "is a file"],
+    ),
+    (
+        "study-results-is-folder",
+        lambda t: [
+            "study",
+            str(study_file(t)),
+            "--out",
+            str(new_dir(new_dir(t, "o"), "results.csv").parent),
+        ],
+        ["results.csv is a directory"],
+    ),
+    (
+        "study-runs-is-file",
+        lambda t: [
+            "study",
+            str(study_file(t)),
+            "--out",
+            str(plain_file(new_dir(t, "o"), "runs").parent),
+        ],
+        ["runs is a file"],
+    ),
+    ("run-out-proc", lambda t: [*RUN, "--out", "/proc/mission-run"], ["cannot write in '/proc'"]),
+    (
+        "study-runs-under-file",
+        lambda t: ["study", str(study_file(t)), "--runs", str(plain_file(t) / "r")],
+        ["--runs", "under"],
+    ),
+    # --- signing keys ------------------------------------------------------------------
+    ("key-missing", lambda t: [*RUN, "--signing-key", str(t / "none.key")], ["none.key"]),
+    (
+        "key-short",
+        lambda t: [*RUN, "--signing-key", str(key_file(t, b"0" * 31))],
+        ["link.key", "31 bytes"],
+    ),
+    (
+        "key-not-hex",
+        lambda t: [*RUN, "--signing-key", str(key_file(t, b"g" * 64))],
+        ["link.key", "hexadecimal"],
+    ),
+    (
+        "key-vehicle",
+        lambda t: ["--vehicle", "work", "--signing-key", str(key_file(t, b"1" * 33))],
+        ["link.key"],
+    ),
+]

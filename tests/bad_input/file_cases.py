@@ -1,0 +1,255 @@
+"""Bad files: scenario YAML, what a run asks of the machine, the safety margins' settings and
+waypoint files (id, argv builder, texts the one error line must hold)."""
+
+from __future__ import annotations
+
+from mission.link.waypoints import HEADER
+from tests.bad_input.builders import (
+    FAR_BOX,
+    GOOD_ROW,
+    HUGE_WORKSPACE,
+    MANY_PARTICLES,
+    RAISED_LIMIT,
+    RUN,
+    TWO_ZONES,
+    mesh_file,
+    plan_dir,
+    raw_file,
+    scenario_file,
+    wpl_args,
+    wpl_rows,
+)
+
+FILE_CASES = [
+    # --- safety margins ----------------------------------------------------------------
+    (
+        "yaml-negative-margin",
+        lambda t: [*RUN, str(scenario_file(t, "control: {clearance_m: -1}\n"))],
+        ["bad.yaml", "control.clearance_m", "must not be negative"],
+    ),
+    (
+        "yaml-negative-radius",
+        lambda t: [*RUN, str(scenario_file(t, "vehicle: {radius_m: -0.1}\n"))],
+        ["bad.yaml", "vehicle.radius_m", "must be positive"],
+    ),
+    (
+        "yaml-separation-below-two-bodies",
+        lambda t: [*RUN, str(scenario_file(t, "control: {min_separation_m: 0.3}\n"))],
+        ["bad.yaml", "control.min_separation_m", "two bodies' radii"],
+    ),
+    (
+        "yaml-clearance-below-a-body",
+        lambda t: [*RUN, str(scenario_file(t, "control: {clearance_m: 0.1}\n"))],
+        ["bad.yaml", "control.clearance_m", "a body's radius"],
+    ),
+    (
+        "run-plan-breaks-separation",
+        lambda t: [*RUN, str(scenario_file(t, "control: {min_separation_m: 3.5}\n"))],
+        ["support-1.waypoints", "item", "control.min_separation_m (3.5 m)"],
+    ),
+    (
+        "run-plan-breaks-clearance",
+        lambda t: [*RUN, str(scenario_file(t, "control: {clearance_m: 1.5}\n"))],
+        ["work.waypoints", "item", "control.clearance_m (1.5 m)"],
+    ),
+    # --- scenario YAML -----------------------------------------------------------------
+    (
+        "yaml-syntax",
+        lambda t: [*RUN, str(scenario_file(t, "control: {horizon_steps: [\n"))],
+        ["bad.yaml"],
+    ),
+    (
+        "yaml-not-a-mapping",
+        lambda t: [*RUN, str(raw_file(t, "- 1\n- 2\n"))],
+        ["raw.yaml", "mapping"],
+    ),
+    (
+        "unknown-key",
+        lambda t: [*RUN, str(scenario_file(t, "control: {horizon: 5}\n"))],
+        ["bad.yaml", "horizon"],
+    ),
+    (
+        "wrong-type",
+        lambda t: [*RUN, str(scenario_file(t, "control: {horizon_steps: five}\n"))],
+        ["bad.yaml", "horizon_steps"],
+    ),
+    (
+        "negative-time",
+        lambda t: [*RUN, str(scenario_file(t, "control: {t_pred_s: -1.0}\n"))],
+        ["bad.yaml", "t_pred_s", "positive"],
+    ),
+    (
+        "bad-choice",
+        lambda t: [*RUN, str(scenario_file(t, "control: {los_penalty: nearest}\n"))],
+        ["bad.yaml", "los_penalty"],
+    ),
+    (
+        "zero-sigma-limit",
+        lambda t: [*RUN, str(scenario_file(t, "control: {support_max_sigma0_m: 0}\n"))],
+        ["bad.yaml", "support_max_sigma0_m"],
+    ),
+    (
+        "nan-number",
+        lambda t: [*RUN, str(scenario_file(t, "gnss: {sigma_uere_m: .nan}\n"))],
+        ["bad.yaml", "sigma_uere_m"],
+    ),
+    (
+        "bad-epoch",
+        lambda t: [*RUN, str(scenario_file(t, "run: {epoch_utc: yesterday}\n"))],
+        ["bad.yaml", "epoch_utc"],
+    ),
+    (
+        "extends-missing",
+        lambda t: [*RUN, str(raw_file(t, "extends: nowhere.yaml\nname: x\n"))],
+        ["nowhere"],
+    ),
+    (
+        "extends-itself",
+        lambda t: [*RUN, str(raw_file(t, "extends: raw.yaml\nname: x\n"))],
+        ["raw.yaml"],
+    ),
+    (
+        "mesh-missing",
+        lambda t: [*RUN, str(scenario_file(t, "world: {structure: {mesh_file: gone.stl}}\n"))],
+        ["gone.stl"],
+    ),
+    (
+        "mesh-garbage",
+        lambda t: [*RUN, str(mesh_file(t, b"\x00\x01not a mesh at all" * 3))],
+        ["junk.stl"],
+    ),
+    (
+        "mesh-no-faces",
+        lambda t: [*RUN, str(mesh_file(t, b"v 0 0 0\nv 1 0 0\n", "flat.obj"))],
+        ["flat.obj"],
+    ),
+    # --- what a run would ask of the machine --------------------------------------------------
+    (
+        "yaml-voxel-tiny",
+        lambda t: [*RUN, str(scenario_file(t, "map: {voxel_size_m: 0.01}\n"))],
+        ["map.voxel_size_m", "50 x 40 x 20 m", "limits.max_map_voxels"],
+    ),
+    (
+        "yaml-workspace-huge",
+        lambda t: [*RUN, str(scenario_file(t, HUGE_WORKSPACE))],
+        ["map.voxel_size_m", "40000 x 40000 x 100 m", "GB"],
+    ),
+    (
+        "yaml-mpc-window",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, "map: {voxel_size_m: 0.5}\ncontrol: {horizon_steps: 25}\n")),
+        ],
+        ["map.voxel_size_m", "limits.max_mpc_window_voxels"],
+    ),
+    (
+        "yaml-particles",
+        lambda t: [*RUN, str(scenario_file(t, "fusion: {broad_particles: 1000000}\n"))],
+        ["fusion.broad_particles", "limits.max_particles"],
+    ),
+    (
+        "yaml-horizon",
+        lambda t: [*RUN, str(scenario_file(t, "control: {horizon_steps: 500}\n"))],
+        ["control.horizon_steps", "limits.max_horizon_steps"],
+    ),
+    (
+        "yaml-cycles",
+        lambda t: [*RUN, str(scenario_file(t, "control: {t_cont_s: 0.0001}\n"))],
+        ["control.t_cont_s", "limits.max_control_cycles"],
+    ),
+    (
+        "yaml-memory",
+        lambda t: [*RUN, str(scenario_file(t, RAISED_LIMIT))],
+        ["map.voxel_size_m", "limits.max_memory_fraction", "this machine"],
+    ),
+    (
+        "yaml-particle-memory",
+        lambda t: [*RUN, str(scenario_file(t, MANY_PARTICLES))],
+        ["fusion.broad_particles", "limits.max_memory_fraction", "this machine"],
+    ),
+    (
+        "mesh-far-away",
+        lambda t: [*RUN, str(mesh_file(t, b"v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n", "far.obj"))],
+        ["far.obj", "from the anchor"],
+    ),
+    (
+        "yaml-box-far-away",
+        lambda t: [*RUN, str(scenario_file(t, FAR_BOX))],
+        ["bad.yaml", "world.structure.primitives[0].max_m", "at most"],
+    ),
+    (
+        "yaml-zone-name-newline",
+        lambda t: [*RUN, str(scenario_file(t, TWO_ZONES.format(name='"a\\nb"')))],
+        ["bad.yaml", "duplicate zone name", "a\\nb"],
+    ),
+    (
+        "yaml-key-newline",
+        lambda t: [*RUN, str(scenario_file(t, '"con\\ntrol": {}\n'))],
+        ["bad.yaml", "con\\ntrol", "unknown key"],
+    ),
+    (
+        "scenario-file-newline",
+        lambda t: [*RUN, str(t / "bad\nname.yaml")],
+        ["bad\\nname.yaml", "no such scenario file"],
+    ),
+    (
+        "plan-dir-missing",
+        lambda t: [*RUN, str(scenario_file(t, "task: {waypoints_dir: nowhere}\n"))],
+        ["nowhere"],
+    ),
+    # --- waypoint files ----------------------------------------------------------------
+    ("wpl-header", lambda t: wpl_args(t, "QGC WPL 100\n" + GOOD_ROW), ["work.waypoints", "line 1"]),
+    ("wpl-empty", lambda t: wpl_args(t, ""), ["work.waypoints"]),
+    (
+        "wpl-columns",
+        lambda t: wpl_args(t, HEADER + "\n" + GOOD_ROW + "2\t0\t3\n"),
+        ["work.waypoints", "line 3"],
+    ),
+    (
+        "wpl-not-a-number",
+        lambda t: wpl_args(t, HEADER + "\n" + GOOD_ROW.replace("35.15", "north")),
+        ["work.waypoints", "line 2"],
+    ),
+    (
+        "wpl-latitude",
+        lambda t: wpl_args(t, HEADER + "\n" + GOOD_ROW.replace("35.15", "135.15")),
+        ["work.waypoints", "line 2"],
+    ),
+    (
+        "wpl-home-only",
+        lambda t: wpl_args(t, wpl_rows()),
+        ["work.waypoints", "at least one waypoint"],
+    ),
+    (
+        "wpl-too-many",
+        lambda t: wpl_args(t, wpl_rows(*[7.0] * 600)),
+        ["work.waypoints", "mission_capacity"],
+    ),
+    ("wpl-unequal", lambda t: wpl_args(t, wpl_rows(7.0)), ["support-1.waypoints", "pair by index"]),
+    (
+        "wpl-frame",
+        lambda t: wpl_args(t, wpl_rows(7.0, frame=1)),
+        ["work.waypoints", "item 1", "frame"],
+    ),
+    ("wpl-command", lambda t: wpl_args(t, wpl_rows(7.0, command=178)), ["item 1", "command 178"]),
+    (
+        "wpl-in-deck",
+        lambda t: wpl_args(t, wpl_rows(8.5)),
+        ["work.waypoints", "inside the structure"],
+    ),
+    (
+        "wpl-too-high",
+        lambda t: wpl_args(t, wpl_rows(50.0)),
+        ["work.waypoints", "outside the workspace"],
+    ),
+    (
+        "wpl-gcs-in-deck",
+        lambda t: ["--waypoints", str(plan_dir(t, "support-3", wpl_rows(8.5)))],
+        ["support-3.waypoints", "inside the structure"],
+    ),
+    (
+        "wpl-gcs-file",
+        lambda t: ["--waypoints", str(plan_dir(t, "support-2", "garbage\n"))],
+        ["support-2.waypoints", "line 1"],
+    ),
+]
