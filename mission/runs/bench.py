@@ -17,6 +17,7 @@ from typing import Any
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.procs.machine_speed import python_loop_s
 from mission.runs.bench_margins import bench_margins
 from mission.runs.bench_result import BenchResult
 from mission.runs.bench_study import bench_studies
@@ -328,12 +329,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
 def bench_machine_speed(repeats: int = 5) -> BenchResult:
     """CPU seconds of a fixed pure-Python loop: how fast this machine is right now (a shared
     VM's speed drifts by tens of per cent within hours, and every other row moves with it)."""
-    times = []
-    for _ in range(repeats):
-        start = time.process_time()
-        sum(range(10_000_000))
-        times.append(time.process_time() - start)
-    return BenchResult("machine_python_loop_s", statistics.median(times), "s", "reference", None)
+    return BenchResult("machine_python_loop_s", python_loop_s(repeats), "s", "reference", None)
 
 
 def run_benchmarks(only: list[str] | None = None) -> list[BenchResult]:

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, Protocol, TextIO
 
 from mission.procs.atomic import write_text_atomically
+from mission.procs.machine_speed import REFERENCE_LOOP_S, python_loop_s
 from mission.studies.execute import Keep, finished_summary
 from mission.studies.local_engine import Done
 from mission.studies.report import write_report
@@ -25,7 +26,6 @@ from mission.studies.table3 import write_tables
 
 REPORT_EVERY_S = 60.0  # the report and its figures, while runs finish (and at the end)
 RUN_CPU_S = 7.0  # CPU-seconds of a run's processes (docs/benchmarks.md), at REFERENCE_LOOP_S
-REFERENCE_LOOP_S = 0.146  # the machine those were measured on (`machine_python_loop_s`)
 WARN_AFTER_S = 3600.0  # a study expected to take longer is announced with its estimate
 
 
@@ -150,9 +150,7 @@ def duration_note(runs: int, cores: int | None) -> str | None:
     per_core = runs * RUN_CPU_S
     if per_core / (cores or 1) < WARN_AFTER_S / 4:  # surely under an hour: no measuring
         return None
-    from mission.runs.bench import bench_machine_speed
-
-    per_core *= bench_machine_speed(repeats=1).value / REFERENCE_LOOP_S
+    per_core *= python_loop_s(repeats=1) / REFERENCE_LOOP_S
     wall = per_core / (cores or 1)
     if wall < WARN_AFTER_S:
         return None

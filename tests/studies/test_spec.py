@@ -140,19 +140,16 @@ def test_a_missing_study_file_is_named(tmp_path):
 
 
 def test_a_study_over_an_hour_is_announced_with_its_estimate(monkeypatch):
-    import mission.runs.bench
-    from mission.runs.bench_result import BenchResult
-    from mission.studies.study import REFERENCE_LOOP_S, duration_note
+    import mission.studies.study as study
+    from mission.procs.machine_speed import REFERENCE_LOOP_S
+    from mission.studies.study import duration_note
 
-    def reference_speed(repeats: int = 5) -> BenchResult:
-        return BenchResult("machine_python_loop_s", REFERENCE_LOOP_S, "s", "reference", None)
-
-    def unmeasured(repeats: int = 5) -> BenchResult:
+    def unmeasured(repeats: int = 5) -> float:
         raise AssertionError("a small study measures nothing")
 
-    monkeypatch.setattr(mission.runs.bench, "bench_machine_speed", unmeasured)
+    monkeypatch.setattr(study, "python_loop_s", unmeasured)
     assert duration_note(60, 2) is None  # Table 3: minutes
-    monkeypatch.setattr(mission.runs.bench, "bench_machine_speed", reference_speed)
+    monkeypatch.setattr(study, "python_loop_s", lambda repeats=5: REFERENCE_LOOP_S)
     assert duration_note(1000, 2) is None  # 3,500 s: just under the hour
     note = duration_note(1_000_000, 2)  # 7 CPU-s a run on 2 cores: 3.5e6 s
     assert note is not None and "about 40.5 days on 2 cores" in note
