@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any, Literal, Protocol
 
 from mission.analysis.run_metrics import run_metrics
+from mission.config.errors import InputError
 from mission.config.settings import Scenario
 from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
@@ -91,20 +92,46 @@ def run_mission(
     # (a background job): its forked children take Python's default handlers back.
     with StopRequest() as stop:
         try:
-            gcs = _start_processes(options, scenario, children)
-            _supervise(gcs, children, {"work"}, watcher, stop)
-            if gcs.process.returncode != 0:
-                raise RunFailed(
-                    f"ground_station exited with status {gcs.process.returncode} (see {gcs.log})"
-                )
-        finally:
-            _stop_all(children)
+            try:
+                gcs = _start_processes(options, scenario, children)
+                _supervise(gcs, children, {"work"}, watcher, stop)
+                if gcs.process.returncode != 0:
+                    status = gcs.process.returncode
+                    raise RunFailed(f"ground_station exited with status {status}{_why(gcs.log)}")
+            finally:
+                _stop_all(children)
+        except RunFailed as failure:  # what the run got to, and why it ended, is kept
+            _write_failed_summary(options, scenario, time.monotonic() - start, str(failure))
+            raise
         stop.check()  # a request whose exception was swallowed: the run was cancelled
     if watcher is not None:
         watcher.finish()
     summary = _summary(options, scenario, time.monotonic() - start)
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
+
+
+def _why(log: Path) -> str:
+    """': <the ground station's last word> (see LOG)', or ' (see LOG)'."""
+    try:
+        lines = log.read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError:
+        lines = []
+    said = [line.split(": ", 1)[1] for line in lines if line.startswith("ground station: ")]
+    return f": {said[-1]} (see {log})" if said else f" (see {log})"
+
+
+def _write_failed_summary(
+    options: RunOptions, scenario: Scenario, wall: float, reason: str
+) -> None:
+    """summary.json of a run that failed: the tlog's metrics as far as it got (none if it
+    holds nothing readable), and ``failed``: why."""
+    try:
+        summary = _summary(options, scenario, wall)
+    except (InputError, ValueError, OSError):  # nothing readable recorded
+        summary = {"scenario": scenario.name, "method": options.method, "seed": options.seed}
+    summary["failed"] = reason
+    write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
 
 
 def _common_arguments(options: RunOptions) -> list[str]:

@@ -206,3 +206,9 @@ def test_escape_starts_are_asked_for_where_g_has_risen_unless_switched_off(escap
     assert not support_request(state, "support-1", work, models).escape  # G as predicted
     models.g.values += 2.0  # GNSS worse everywhere than the prior map said
     assert support_request(state, "support-1", work, models).escape is escape_starts
+
+
+def test_a_vehicle_is_lost_after_simulated_seconds_and_never_a_wall_moment(along, tmp_path):
+    assert _config(along, tmp_path).silence_limit_s == 3.0  # lockstep: 3 s of simulated time
+    assert _config(along, tmp_path, speedup=0.5).silence_limit_s == 3.0  # 6 s of wall time
+    assert _config(along, tmp_path, speedup=10.0).silence_limit_s == 20.0  # 2 s, not 0.3 s

@@ -226,8 +226,11 @@ def test_a_silent_work_uav_ends_the_run_from_the_ground_station(scenario, tmp_pa
         if run.poll() is None:
             run.send_signal(signal.SIGKILL)
     assert run.returncode == 1
-    assert "ground_station exited with status 1" in stderr
+    assert "ground_station exited with status 1: work lost: no message for 3.0 s" in stderr
     assert "work lost: no message for 3.0 s" in (out / "ground_station.log").read_text()
+    summary = json.loads((out / "summary.json").read_text())  # what it got to, and why not on
+    assert "work lost: no message for 3.0 s" in summary["failed"]
+    assert not summary["completed"] and summary["control_cycles"] >= 40
     trace = read_tlog(out / "gcs.tlog", load_scenario(str(scenario)))
     assert len(trace.ticks) >= 40
     assert _pids(str(scenario)) == []
