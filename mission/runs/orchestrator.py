@@ -101,6 +101,7 @@ def run_mission(
             finally:
                 _stop_all(children)
         except RunFailed as failure:  # what the run got to, and why it ended, is kept
+            stop.check()  # unless it was cancelled: then it is not a result of any kind
             _write_failed_summary(options, scenario, time.monotonic() - start, str(failure))
             raise
         stop.check()  # a request whose exception was swallowed: the run was cancelled
