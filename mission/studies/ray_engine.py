@@ -10,7 +10,9 @@ vehicles and ground station with that.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import re
 import shutil
 import socket
 import tempfile
@@ -24,7 +26,8 @@ from mission.studies.execute import Keep, conclude, pack, prepare, start, this_n
 from mission.studies.local_engine import Done
 from mission.studies.runkeys import StudyRun
 
-INSTALL_HINT = "the Ray engine needs Ray: pip install -e '.[ray]' (or pip install 'ray>=2.9')"
+MIN_RAY = (2, 59)  # token authentication on by default for a local instance
+INSTALL_HINT = "the Ray engine needs Ray 2.59 or later: pip install -e '.[ray]'"
 CORES_PER_RUN = 1  # the ground station's core; the vehicles sleep most of a step
 WAIT_S = 0.5
 REACH_S = 10.0  # how long a cluster's head may take to accept a connection
@@ -55,6 +58,9 @@ def require_ray() -> Any:
         import ray
     except ImportError:
         raise InputError("command line", "--engine ray", INSTALL_HINT) from None
+    version = tuple(int(part) for part in re.findall(r"\d+", ray.__version__)[:2])
+    if version < MIN_RAY:  # before 2.59 a local Ray listened on every interface, unauthenticated
+        raise InputError("command line", "--engine ray", f"Ray {ray.__version__}: {INSTALL_HINT}")
     return ray
 
 
@@ -85,8 +91,18 @@ class RayEngine:
         ray = require_ray()
         os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # no usage reports
         started_here = not ray.is_initialized()
-        if started_here:
-            _start_ray(ray, self.address, self.jobs)
+        with contextlib.ExitStack() as cleanup:
+            if started_here:
+                _start_ray(ray, self.address, self.jobs)
+                cleanup.callback(ray.shutdown)
+                if not (self.address or os.environ.get("RAY_ADDRESS")):
+                    keep_token_private()
+            self._run_tasks(ray, runs, runs_dir, keep, done)
+
+    def _run_tasks(
+        self, ray: Any, runs: list[StudyRun], runs_dir: Path, keep: Keep, done: Done
+    ) -> None:
+        """Submit the runs, at most ``jobs`` in flight, and collect them as they finish."""
         task = ray.remote(num_cpus=CORES_PER_RUN, max_retries=0)(run_on_node)
         queue = list(runs)
         in_flight: dict[Any, StudyRun] = {}
@@ -103,17 +119,24 @@ class RayEngine:
         finally:
             for ref in in_flight:
                 ray.cancel(ref, force=True)
-            if started_here:
-                ray.shutdown()
 
 
 def _start_ray(ray: Any, address: str | None, jobs: int | None) -> None:
     address = address or os.environ.get("RAY_ADDRESS")
     quiet = {"log_to_driver": False, "configure_logging": True, "logging_level": "ERROR"}
-    if address:
+    if address:  # the cluster's own authentication (RAY_AUTH_MODE=token, docs/studies.md)
         ray.init(address=address, **quiet)
     else:
         ray.init(num_cpus=jobs or os.cpu_count() or 1, include_dashboard=False, **quiet)
+
+
+def keep_token_private(home: Path | None = None) -> None:
+    """A local Ray (2.59+) authenticates every call with the token in ~/.ray/auth_token,
+    which it writes readable by every local user: make it the owner's alone."""
+    token = (home or Path.home()) / ".ray" / "auth_token"
+    with contextlib.suppress(OSError):  # none, or not ours: Ray's own doing
+        if token.is_file() and token.stat().st_mode & 0o077:
+            token.chmod(0o600)
 
 
 def _collect(ray: Any, ref: Any, run: StudyRun, runs_dir: Path, done: Done) -> None:

@@ -136,3 +136,20 @@ def _running(marker: str) -> list[str]:
 def _ray_processes() -> int:
     found = subprocess.run(["pgrep", "-c", "-f", "raylet|gcs_server"], capture_output=True)
     return int(found.stdout.strip() or 0)
+
+
+def test_a_local_rays_token_is_made_private_and_an_old_ray_is_refused(monkeypatch, tmp_path):
+    ray = pytest.importorskip("ray")
+    from mission.config.errors import InputError
+    from mission.studies.ray_engine import keep_token_private, require_ray
+
+    token = tmp_path / ".ray" / "auth_token"
+    token.parent.mkdir()
+    token.write_text("secret")
+    token.chmod(0o644)  # as Ray writes it
+    keep_token_private(tmp_path)
+    assert token.stat().st_mode & 0o777 == 0o600
+    keep_token_private(tmp_path / "nobody")  # no token: nothing to do
+    monkeypatch.setattr(ray, "__version__", "2.58.1")
+    with pytest.raises(InputError, match=r"Ray 2\.58\.1: the Ray engine needs Ray 2\.59 or later"):
+        require_ray()
