@@ -25,6 +25,7 @@ from mission.procs.cli_common import (
     check_speedup,
     die_with_parent,
     name_this_process,
+    program_name,
     run_guarded,
 )
 from mission.procs.outputs import check_output_dir, check_output_file
@@ -34,7 +35,7 @@ from mission.world.model import KnownWorld
 def build_parser() -> OneLineArgumentParser:
     """Arguments of the ground-station process."""
     parser = OneLineArgumentParser(
-        prog="python -m ground_station",
+        prog=program_name("ground_station", "mission-ground-station"),
         description="The ground station of one mission: fusion, the map G, the MPCs.",
     )
     parser.add_argument("--scenario", default="along", help="embedded name or YAML path")

@@ -10,6 +10,7 @@ from mission import study_commands, subcommands
 from mission.link.impairment import add_link_arguments
 from mission.procs.cli_common import (
     OneLineArgumentParser,
+    program_name,
     run_guarded,
 )
 
@@ -19,7 +20,7 @@ DEFAULT_SCENARIO = "along"
 def build_parser() -> OneLineArgumentParser:
     """The argument parser with every subcommand."""
     parser = OneLineArgumentParser(
-        prog="python -m mission",
+        prog=program_name("mission", "mission"),
         description="Run, batch, analyse and inspect missions of the bridge-inspection UAVs.",
     )
     commands = parser.add_subparsers(

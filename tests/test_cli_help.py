@@ -48,3 +48,19 @@ def test_a_default_of_zero_is_shown_and_an_unset_option_is_not():
     )
     assert "(default: 0)" in help_text  # --seed
     assert "(default: None)" not in help_text and "(default: False)" not in help_text
+
+
+def test_the_commands_are_console_scripts_as_sitl_tools_are():
+    from importlib.metadata import entry_points
+
+    import ground_station.cli
+    import mission.cli
+    import vehicle_sim.cli
+
+    scripts = {e.name: e for e in entry_points(group="console_scripts")}
+    for name, function in [
+        ("mission", mission.cli.entry_point),
+        ("mission-vehicle", vehicle_sim.cli.entry_point),
+        ("mission-ground-station", ground_station.cli.entry_point),
+    ]:
+        assert scripts[name].load() is function

@@ -27,6 +27,7 @@ from mission.procs.cli_common import (
     freeze_startup_heap,
     name_this_process,
     parse_point,
+    program_name,
     run_guarded,
 )
 from mission.world.model import World
@@ -38,7 +39,8 @@ from vehicle_sim.vehicle import Vehicle
 def build_parser() -> OneLineArgumentParser:
     """Arguments of a vehicle process."""
     parser = OneLineArgumentParser(
-        prog="python -m vehicle_sim", description="One simulated UAV speaking MAVLink 2 over UDP."
+        prog=program_name("vehicle_sim", "mission-vehicle"),
+        description="One simulated UAV speaking MAVLink 2 over UDP.",
     )
     parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
     parser.add_argument("--vehicle", required=True, help="work or support-N")

@@ -6,6 +6,7 @@ import argparse
 import os
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 from mission.config.errors import InputError
 
@@ -36,6 +37,12 @@ class OneLineArgumentParser(argparse.ArgumentParser):
         """Report a usage error on one line and exit with status 2."""
         sys.stderr.write(f"{self.prog}: error: {message}\n")
         sys.exit(EXIT_BAD_INPUT)
+
+
+def program_name(module: str, script: str) -> str:
+    """How the user started this command: ``script`` (the console script) or ``python -m
+    module``; for usage lines and errors."""
+    return script if Path(sys.argv[0]).name == script else f"python -m {module}"
 
 
 def run_guarded(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
