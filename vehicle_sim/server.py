@@ -26,7 +26,9 @@ import os
 import select
 import signal
 import socket
+import sys
 import time
+import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -96,6 +98,7 @@ class VehicleServer:
         # The last step's messages, for a repeated tick: encoded afresh when asked again, since
         # a signed link refuses a replayed packet (its signature timestamp must increase).
         self._last_step: list[Any] = []
+        self._reported_errors: set[str] = set()  # handler errors already logged in full
 
     def attach(self, vehicle: Vehicle) -> None:
         """Connect the vehicle whose messages this server carries."""
@@ -196,7 +199,13 @@ class VehicleServer:
         try:
             vehicle.handle(message, now)
         except Exception as error:  # a malformed message never kills the vehicle
-            vehicle.counters.reject(f"handler error {type(error).__name__}")
+            kind = f"handler error {type(error).__name__}"
+            if kind not in self._reported_errors:  # the first of each kind, with where it was
+                self._reported_errors.add(kind)
+                print(f"vehicle: {message.get_type()} raised (first of its kind, counted):",
+                      file=sys.stderr)  # fmt: skip
+                traceback.print_exc()
+            vehicle.counters.reject(kind)
 
     def _on_tick(self, time_s: float, now: float, sender: Address) -> None:
         """The ground station's clock: advance to ``time_s`` (bounded jumps only). A tick for

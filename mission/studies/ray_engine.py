@@ -30,6 +30,7 @@ MIN_RAY = (2, 59)  # token authentication on by default for a local instance
 INSTALL_HINT = "the Ray engine needs Ray 2.59 or later: pip install -e '.[ray]'"
 CORES_PER_RUN = 1  # the ground station's core; the vehicles sleep most of a step
 WAIT_S = 0.5
+FAILURE_FILE = "failure.txt"  # why a task failed, where its folder would have been
 REACH_S = 10.0  # how long a cluster's head may take to accept a connection
 
 
@@ -143,7 +144,10 @@ def _collect(ray: Any, ref: Any, run: StudyRun, runs_dir: Path, done: Done) -> N
     """Unpack a finished task's folder under ``runs_dir`` and report it."""
     try:
         summary, data, wall = ray.get(ref)
-    except Exception:  # the task's worker died (or the task raised): the run failed
+    except Exception as error:  # the task's worker died (or the task raised): the run failed
+        folder = runs_dir / run.folder  # where the progress line says to look
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / FAILURE_FILE).write_text(f"{type(error).__name__}: {error}\n")
         done(run, None, 0.0)
         return
     unpack(data, runs_dir / run.folder)

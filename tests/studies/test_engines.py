@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -153,3 +154,19 @@ def test_a_local_rays_token_is_made_private_and_an_old_ray_is_refused(monkeypatc
     monkeypatch.setattr(ray, "__version__", "2.58.1")
     with pytest.raises(InputError, match=r"Ray 2\.58\.1: the Ray engine needs Ray 2\.59 or later"):
         require_ray()
+
+
+def test_a_failed_ray_task_leaves_its_reason_where_the_progress_line_points(tmp_path):
+    from mission.studies.ray_engine import FAILURE_FILE, _collect
+
+    class _Ray:
+        @staticmethod
+        def get(ref):
+            raise RuntimeError("the worker died: out of memory")
+
+    run = SimpleNamespace(folder="along-ac-0-abc")
+    reported = []
+    _collect(_Ray(), None, run, tmp_path, lambda *args: reported.append(args))
+    assert reported == [(run, None, 0.0)]
+    reason = (tmp_path / "along-ac-0-abc" / FAILURE_FILE).read_text()
+    assert reason == "RuntimeError: the worker died: out of memory\n"
