@@ -46,6 +46,7 @@ def world(args: argparse.Namespace) -> int:
         from mission.analysis.world_plot import plot_world
 
         plot_world(world, np.array(point or DEFAULT_PLOT_POINT), args.plot)
+        print(f"wrote {args.plot}", file=sys.stderr if point is not None else sys.stdout)
     return 0
 
 
@@ -182,10 +183,10 @@ def plan(args: argparse.Namespace) -> int:
     from mission.planning.zone_placement import place_along, place_along_pair, place_wall
     from mission.world.model import World
 
-    if args.plot is not None:
-        _check_output_path(args.plot, "--plot")
     world = World.load(args.scenario)
     out = plan_directory(args.out, world.scenario)
+    if args.plot is not None:
+        _check_output_path(args.plot, "--plot", made=out)
     plan = plan_supports(world)
     for path in write_plan(plan, world.scenario, out):
         print(f"wrote {path}")
@@ -223,6 +224,7 @@ def plan(args: argparse.Namespace) -> int:
         from mission.planning.plan_plot import plot_plan
 
         plot_plan(world, plan, args.plot)
+        print(f"wrote {args.plot}")
     return 0
 
 
@@ -271,7 +273,7 @@ def analyze(args: argparse.Namespace) -> int:
         from mission.procs.atomic import write_text_atomically
 
         write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
-    print(json.dumps(metrics))
+    print(json.dumps(metrics, indent=2))  # stdout is the metrics alone; notes go to stderr
     if args.plots:
         from mission.analysis.metrics import read_tlog
         from mission.analysis.run_plot import RunLabel, plot_run
@@ -280,7 +282,7 @@ def analyze(args: argparse.Namespace) -> int:
         trace = read_tlog(tlog, scenario)
         label = RunLabel(scenario.name, previous.get("method"), previous.get("seed"))
         for path in plot_run(trace, World(scenario), tlog.parent / "g", plots, label):
-            print(f"wrote {path}")
+            print(f"wrote {path}", file=sys.stderr)
     return 0
 
 
@@ -386,7 +388,13 @@ def bench(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_output_path(path: Path, flag: str) -> None:
+def _check_output_path(path: Path, flag: str, made: Path | None = None) -> None:
+    """A figure's path; its folder may be ``made`` (checked as a folder this command makes)."""
     from mission.analysis.figures import FIGURE_SUFFIXES
 
+    if made is not None and Path(path).parent.resolve() == Path(made).resolve():
+        check_output_dir(made, flag)
+        if Path(path).is_dir() or Path(path).suffix.lower() not in FIGURE_SUFFIXES:
+            check_output_file(path, flag, FIGURE_SUFFIXES)  # says which
+        return
     check_output_file(path, flag, FIGURE_SUFFIXES)
