@@ -52,3 +52,7 @@ def test_planning_leaves_the_shipped_plans_alone(monkeypatch, tmp_path, capsys):
     assert {p.name: p.read_bytes() for p in written.iterdir()} == before  # the same plan
     assert f"waypoints_dir: {written}" in capsys.readouterr().out
     assert entry_point(["plan", "along", "--out", str(SHIPPED)]) == 2
+    fresh = tmp_path / "fresh"  # the figure may go into the folder the plan makes
+    assert entry_point(["plan", "along", "--out", str(fresh), "--plot", str(fresh / "p.png")]) == 0
+    assert (fresh / "p.png").read_bytes()[:4] == b"\x89PNG"
+    assert f"wrote {fresh / 'p.png'}" in capsys.readouterr().out
