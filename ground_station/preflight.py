@@ -3,6 +3,7 @@ mission protocol, then GUIDED and armed, each command acknowledged."""
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 
@@ -22,6 +23,8 @@ def connect(links: VehicleLinks, timeout_wall_s: float) -> None:
     """Wait for every vehicle's heartbeat (announcing ourselves so they answer)."""
     beat = gcs_heartbeat()
     views = links.views.values()
+    names = ", ".join(f"{v.name} {v.address[0]}:{v.address[1]}" for v in views)
+    print(f"ground station waiting up to {timeout_wall_s:g} s for {names}", file=sys.stderr)
     deadline = time.monotonic() + timeout_wall_s
     while time.monotonic() < deadline:
         for view in views:

@@ -136,6 +136,12 @@ def realtime_speedup(args: argparse.Namespace) -> float | None:
         return None
     speedup = 1.0 if args.speedup is None else args.speedup
     check_speedup(speedup)
+    if args.speedup is None:
+        print(
+            "real time at 1x: a run takes as long as its flight (minutes); "
+            "--speedup X runs X times faster",
+            file=sys.stderr,
+        )
     return speedup
 
 

@@ -12,7 +12,7 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
@@ -332,20 +332,29 @@ def bench_machine_speed(repeats: int = 5) -> BenchResult:
     return BenchResult("machine_python_loop_s", python_loop_s(repeats), "s", "reference", None)
 
 
-def run_benchmarks(only: list[str] | None = None) -> list[BenchResult]:
-    """Run the chosen benchmark groups (all by default), after the machine's speed."""
+def run_benchmarks(
+    only: list[str] | None = None, progress: TextIO | None = None
+) -> list[BenchResult]:
+    """Run the chosen benchmark groups (all by default), after the machine's speed; each
+    group's start and duration on ``progress`` (stderr by default: some take minutes)."""
+    progress = progress or sys.stderr
     results: list[BenchResult] = [bench_machine_speed()]
     for name, bench in BENCHMARKS.items():
         if only is None or name in only:
+            start = time.monotonic()
+            progress.write(f"bench: {name} ...\n")
+            progress.flush()
             results.extend(bench())
+            progress.write(f"bench: {name} done in {time.monotonic() - start:.0f} s\n")
     return results
 
 
 def format_table(results: list[BenchResult]) -> str:
     """A plain-text table of results."""
-    lines = [f"{'benchmark':<32} {'value':>12} {'unit':<8} {'target':<10} ok"]
+    width = max([len("benchmark"), *(len(r.name) for r in results)])
+    lines = [f"{'benchmark':<{width}} {'value':>12} {'unit':<8} {'target':<10} ok"]
     lines += [
-        f"{r.name:<32} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {_verdict(r.ok)}"
+        f"{r.name:<{width}} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {_verdict(r.ok)}"
         for r in results
     ]
     return "\n".join(lines)

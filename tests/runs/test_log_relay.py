@@ -32,3 +32,17 @@ def test_each_news_line_is_shown_once_and_only_when_whole(tmp_path, capsys):
 def test_a_missing_log_is_no_news(tmp_path, capsys):
     LogRelay(tmp_path / "none.log", COMPILE_NEWS).poll()
     assert capsys.readouterr().err == ""
+
+
+def test_a_first_runs_compile_time_is_read_from_the_ground_stations_log(tmp_path):
+    from mission.runs.orchestrator import _compile_time
+
+    log = tmp_path / "ground_station.log"
+    log.write_text(
+        "ground station listening on 127.0.0.1:5000\n"
+        "ground station: compiling the support MPC with gcc: once per machine, cached\n"
+        "ground station: compiled the support MPC in 26.3 s\n"
+    )
+    assert _compile_time(log) == 26.3  # left out of the run's real-time factor
+    log.write_text("ground station listening on 127.0.0.1:5000\n")
+    assert _compile_time(log) == 0.0 and _compile_time(tmp_path / "none.log") == 0.0
