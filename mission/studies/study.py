@@ -89,12 +89,13 @@ def run_study(
 
     def done(run: StudyRun, summary: dict | None, wall: float) -> None:
         nonlocal last_report
+        name = run.folder if len(spec.points) == 1 else f"{run.folder} [{_label(run)}]"
         if summary is None:
             failed.append(run.folder)
-            bar.advance(f"{run.folder}: FAILED (see {runs_dir / run.folder})")
+            bar.advance(f"{name}: FAILED (see {runs_dir / run.folder})")
         else:
             summaries[run] = summary
-            bar.advance(f"{run.folder}: {_one_line(summary)}")
+            bar.advance(f"{name}: {_one_line(summary)}")
         report = time.monotonic() - last_report > REPORT_EVERY_S
         write_outputs(out_dir, spec, runs, summaries, len(failed), report)
         last_report = time.monotonic() if report else last_report
@@ -142,6 +143,11 @@ def _one_line(summary: dict[str, Any]) -> str:
         f"{done}, {summary['multipath_steps_total']} steps in multipath, "
         f"wall {summary['wall_time_s']:.1f} s"
     )
+
+
+def _label(run: StudyRun) -> str:
+    """The run's point: ``key=value, ...`` (``defaults`` for none)."""
+    return ", ".join(f"{k}={v}" for k, v in run.overrides.items()) or "defaults"
 
 
 def duration_note(runs: int, cores: int | None) -> str | None:

@@ -43,6 +43,7 @@ class FakeEngine:
     """Writes each run's summary as `mission run` would, without running anything."""
 
     description = "fake engine"
+    cores = 1
 
     def __init__(self, fail_seed: int | None = None) -> None:
         self.ran: list[str] = []
@@ -84,6 +85,9 @@ def test_a_study_writes_its_results_and_report_and_a_rerun_skips_everything(tmp_
     again = run_study(_spec(), tmp_path, FakeEngine(), progress=progress)
     assert (again.finished, again.skipped) == (0, 12)
     assert "12 already finished" in progress.getvalue()
+    first = io.StringIO()
+    run_study(_spec(), tmp_path / "named", FakeEngine(), progress=first)
+    assert "along-ac-0-" in first.getvalue() and " [map.eta=0.3]: " in first.getvalue()
     assert {p: p.read_bytes() for p in before} == before
 
 
