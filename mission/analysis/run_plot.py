@@ -20,6 +20,7 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.patches import Patch
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from mission.analysis.figures import save_figure
@@ -136,19 +137,25 @@ def _trajectories(
 
 
 def _error(trace: RunTrace, world: World, path: Path, label: RunLabel) -> None:
+    """The work UAV's error over time, each support's cycles in a zone shaded in its colour."""
     times, errors = work_errors(trace)
-    in_zone = zone_steps(trace, world).get(2, [])
+    steps = zone_steps(trace, world)
     fig, ax = plt.subplots(figsize=(11, 4))
     half = world.scenario.control.t_cont_s / 2
-    for t in in_zone:
-        ax.axvspan(t - half, t + half, color="red", alpha=0.25, lw=0)
-    ax.plot(times, errors, color="k", lw=0.8, label="|xhat - x|")
-    ax.axvspan(0, 0, color="red", alpha=0.25, label="support 1 in a zone")
+    (line,) = ax.plot(times, errors, color="k", lw=0.8, label="|xhat - x|")
+    handles = [line]
+    for system in sorted(steps):
+        color = COLORS.get(system, "tab:gray")
+        for t in steps[system]:
+            ax.axvspan(t - half, t + half, color=color, alpha=0.25, lw=0)
+        name = f"support {system - 1} in a zone ({len(steps[system])} cycles)"
+        handles.append(Patch(color=color, alpha=0.25, label=name))
     ax.set_xlabel("simulated time [s]")
     ax.set_ylabel("work UAV localization error [m]")
-    ax.set_title(f"{label}: {len(in_zone)} cycles of support 1 in a zone")
+    total = len({t for cycle_times in steps.values() for t in cycle_times})
+    ax.set_title(f"{label}: {total} cycles with a support in a zone")
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(handles=handles, loc="upper right", fontsize=8)
     fig.tight_layout()
     _save(fig, path)
 
