@@ -63,10 +63,6 @@ class LocalizabilityMap:
         """G_s at points (N, 3), in numpy."""
         return hermite_zero_slope(self.values, self.grid, points)
 
-    def flat_values(self) -> np.ndarray:
-        """Values in the order the casadi interpolant expects (first axis fastest)."""
-        return self.values.ravel(order="F")
-
 
 def learn(
     g: LocalizabilityMap, measurements: Sequence[SupportMeasurement], yhat: dict[str, np.ndarray]

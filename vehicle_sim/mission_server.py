@@ -71,11 +71,6 @@ class MissionServer:
         upload.retries_left -= 1
         self._request(upload, now)
 
-    @property
-    def uploading(self) -> bool:
-        """True while an upload is in progress."""
-        return self._upload is not None
-
     # -- handlers ---------------------------------------------------------------------------
     def _on_count(self, msg: Any, now: float) -> None:
         partner = _partner(msg)

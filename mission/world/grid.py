@@ -43,7 +43,3 @@ class VoxelGrid:
         points = np.atleast_2d(np.asarray(points, dtype=float))
         index = np.floor((points - self.origin_m) / self.voxel_m).astype(int)
         return np.clip(index, 0, np.array(self.shape) - 1)
-
-    def center_of(self, index: np.ndarray) -> np.ndarray:
-        """Centre of the voxel(s) with the given integer index."""
-        return self.origin_m + self.voxel_m * (np.asarray(index, dtype=float) + 0.5)
