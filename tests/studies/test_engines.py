@@ -20,6 +20,7 @@ import mission.cli
 from mission.studies.local_engine import LocalEngine
 from mission.studies.spec import load_study
 from mission.studies.study import run_study
+from tests.extras import required
 from tests.processes import ROOT
 
 # what differs from run to run of the same lockstep mission: timings and where it ran
@@ -47,7 +48,7 @@ def _study(tmp_path: Path, text: str = SMALL_STUDY):
 
 @pytest.mark.slow
 def test_a_two_node_ray_cluster_gives_the_local_engines_results(tmp_path, capsys):
-    ray = pytest.importorskip("ray")
+    ray = required("ray")
     from ray.cluster_utils import Cluster
 
     from mission.studies.ray_engine import RayEngine
@@ -93,7 +94,7 @@ def test_a_two_node_ray_cluster_gives_the_local_engines_results(tmp_path, capsys
 @pytest.mark.parametrize("engine", ["local", "ray"])
 def test_ctrl_c_cancels_a_study_and_leaves_no_process(tmp_path, engine):
     if engine == "ray":
-        pytest.importorskip("ray")
+        required("ray")
     path = tmp_path / "long.yaml"
     path.write_text(SMALL_STUDY.replace("run.timeout_s: 15", "run.timeout_s: 600"))
     marker = "mission-study-" if engine == "ray" else str(tmp_path)
@@ -140,7 +141,7 @@ def _ray_processes() -> int:
 
 
 def test_a_local_rays_token_is_made_private_and_an_old_ray_is_refused(monkeypatch, tmp_path):
-    ray = pytest.importorskip("ray")
+    ray = required("ray")
     from mission.config.errors import InputError
     from mission.studies.ray_engine import keep_token_private, require_ray
 

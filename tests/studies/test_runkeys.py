@@ -57,5 +57,28 @@ def test_a_key_follows_the_contents_of_the_plan_files_not_their_path(tmp_path):
     assert resolved_key(a, Point(())) == resolved_key("along", Point(()))
 
 
-def test_the_code_version_is_a_stable_digest():
-    assert code_version() == code_version() and len(code_version()) == 64
+def test_the_code_version_follows_the_code_a_run_executes(tmp_path, monkeypatch):
+    """A byte changed in a module a run executes changes the digest; a file it does not
+    read (a note, a cache) does not."""
+    import shutil
+    from importlib import resources
+
+    import mission.studies.runkeys as runkeys
+
+    copy = tmp_path / "ground_station"
+    shutil.copytree(Path(str(resources.files("ground_station"))), copy)
+    real = resources.files
+
+    def files(package: str):
+        return copy if package == "ground_station" else real(package)
+
+    monkeypatch.setattr(runkeys.resources, "files", files)
+    before = code_version()
+    assert len(before) == 64 and before == code_version()
+    (copy / "NOTES.md").write_text("not code")
+    (copy / "__pycache__" / "x.pyc").parent.mkdir(exist_ok=True)
+    (copy / "__pycache__" / "x.pyc").write_bytes(b"cache")
+    assert code_version() == before
+    fusion = copy / "fusion.py"
+    fusion.write_text(fusion.read_text() + "\n# a comment is code too: the digest is of bytes\n")
+    assert code_version() != before

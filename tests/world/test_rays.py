@@ -5,11 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mission.world.rays import EmbreeRays, TrimeshRays, rtcore_scene
+from mission.world.rays import EmbreeRays, TrimeshRays
+from tests.extras import embree_available
 
 
-@pytest.mark.skipif(rtcore_scene is None, reason="embreex has no wheel for this machine")
 def test_embree_and_trimesh_agree_on_rays_and_segments(along_world):
+    if not embree_available():
+        pytest.skip("embreex has no wheel for this machine")
     structure = along_world.structure
     embree = EmbreeRays(structure.vertices, structure.faces)
     reference = TrimeshRays(structure.mesh)
