@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
-from mission import study_commands, subcommands
+from mission import run_files_commands, study_commands, subcommands
 from mission.link.impairment import add_link_arguments
 from mission.procs.cli_common import (
     OneLineArgumentParser,
@@ -249,8 +249,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "world": subcommands.world,
         "run": subcommands.run,
         "bench": subcommands.bench,
-        "analyze": subcommands.analyze,
-        "view": subcommands.view,
+        "analyze": run_files_commands.analyze,
+        "view": run_files_commands.view,
         "plan": subcommands.plan,
         "batch": study_commands.batch,
         "study": study_commands.study,
