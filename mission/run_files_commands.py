@@ -14,8 +14,10 @@ from mission.procs.outputs import check_output_dir, check_output_file
 
 
 def analyze(args: argparse.Namespace) -> int:
-    """``mission analyze``."""
-    from mission.analysis.run_metrics import run_metrics
+    """``mission analyze``: the tlog read once, for the metrics and the figures."""
+    from mission.analysis.metrics import read_tlog
+    from mission.analysis.run_metrics import metrics_of
+    from mission.world.model import World
 
     tlog = args.run / "gcs.tlog" if args.run.is_dir() else args.run
     if not tlog.is_file():
@@ -28,7 +30,8 @@ def analyze(args: argparse.Namespace) -> int:
     plots = tlog.parent / "plots"
     if args.plots:
         _check_plots(plots)
-    metrics = run_metrics(tlog, scenario)
+    trace, world = read_tlog(tlog, scenario), World(scenario)
+    metrics = metrics_of(trace, world, tlog.parent, scenario)
     if not metrics["control_cycles"]:
         raise InputError(str(tlog), "", "holds no control cycle of a ground station")
     _check_holds_the_summary(tlog, metrics, previous)
@@ -39,13 +42,10 @@ def analyze(args: argparse.Namespace) -> int:
         write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
     print(json.dumps(metrics, indent=2))  # stdout is the metrics alone; notes go to stderr
     if args.plots:
-        from mission.analysis.metrics import read_tlog
         from mission.analysis.run_plot import RunLabel, plot_run
-        from mission.world.model import World
 
-        trace = read_tlog(tlog, scenario)
         label = RunLabel(scenario.name, previous.get("method"), previous.get("seed"))
-        for path in plot_run(trace, World(scenario), tlog.parent / "g", plots, label):
+        for path in plot_run(trace, world, tlog.parent / "g", plots, label):
             print(f"wrote {path}", file=sys.stderr)
     return 0
 

@@ -8,7 +8,13 @@ from pathlib import Path
 from typing import Any
 
 from mission.analysis.diagnostics import diagnostics, read_records
-from mission.analysis.metrics import measurement_ages, mpc_stats, read_tlog, trace_metrics
+from mission.analysis.metrics import (
+    RunTrace,
+    measurement_ages,
+    mpc_stats,
+    read_tlog,
+    trace_metrics,
+)
 from mission.config.settings import Scenario
 from mission.world.model import World
 
@@ -16,10 +22,14 @@ from mission.world.model import World
 def run_metrics(tlog: Path, scenario: Scenario) -> dict[str, Any]:
     """The tlog's metrics, plus ``mpc_solve_ms`` and ``diagnostics`` where the ground
     station's ``records.jsonl`` lies beside the tlog."""
-    trace = read_tlog(tlog, scenario)
-    world = World(scenario)
+    return metrics_of(read_tlog(tlog, scenario), World(scenario), tlog.parent, scenario)
+
+
+def metrics_of(trace: RunTrace, world: World, run_dir: Path, scenario: Scenario) -> dict[str, Any]:
+    """:func:`run_metrics` of a tlog already read (``trace``), with the records of
+    ``run_dir``: a caller that also plots the run reads the tlog once."""
     metrics = {"mode": trace.mode, **trace_metrics(trace, world)}
-    records_file = tlog.parent / "records.jsonl"
+    records_file = run_dir / "records.jsonl"
     if records_file.is_file():
         records = read_records(records_file)
         metrics["measurement_age_ms"] = measurement_ages(records)
