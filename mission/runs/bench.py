@@ -18,6 +18,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.procs.machine_speed import python_loop_s
+from mission.procs.stopping import stop_processes
 from mission.runs.bench_margins import bench_margins
 from mission.runs.bench_result import BenchResult
 from mission.runs.bench_study import bench_studies
@@ -57,8 +58,7 @@ def bench_vehicle(steps: int = 1000, repeats: int = 3, pings: int = 500) -> list
             rtts.append((time.perf_counter() - sent) * 1000)
         endpoint.close()
     finally:
-        process.terminate()
-        process.wait(timeout=10)
+        stop_processes([process], grace_s=10.0)
     rtt = statistics.median(rtts)
     return [
         BenchResult("vehicle_steps_per_s", steps_per_s, "steps/s", ">= 2000", steps_per_s >= 2000),

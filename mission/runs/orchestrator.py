@@ -31,6 +31,7 @@ from mission.procs.atomic import write_text_atomically
 from mission.procs.cli_common import child_environment
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
+from mission.procs.stopping import stop_processes
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
 SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
@@ -334,13 +335,4 @@ class LogRelay:
 
 
 def _stop_all(children: list[Child]) -> None:
-    for child in children:
-        if child.process.poll() is None:
-            child.process.terminate()
-    deadline = time.monotonic() + 10
-    for child in children:
-        try:
-            child.process.wait(timeout=max(0.1, deadline - time.monotonic()))
-        except subprocess.TimeoutExpired:
-            child.process.kill()
-            child.process.wait()
+    stop_processes((child.process for child in children), grace_s=10.0)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mission.procs.interrupts import StopRequest
+from mission.procs.stopping import stop_processes
 from mission.studies.execute import Keep, conclude, prepare, start, this_node
 from mission.studies.runkeys import StudyRun
 
@@ -63,16 +64,4 @@ class LocalEngine:
                         done(run, conclude(run, runs_dir / run.folder, status, node, keep), wall)
                     time.sleep(POLL_S)
             finally:
-                _stop(process for process, _ in running.values())
-
-
-def _stop(processes) -> None:
-    processes = list(processes)
-    for process in processes:
-        process.terminate()
-    for process in processes:
-        try:
-            process.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
+                stop_processes((process for process, _ in running.values()), grace_s=15.0)

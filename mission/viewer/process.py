@@ -25,6 +25,7 @@ from typing import Literal
 from urllib.parse import quote
 
 from mission.procs.cli_common import die_with_parent
+from mission.procs.stopping import stop_processes
 
 LOOPBACK = "127.0.0.1"
 START_TIMEOUT_S = 30.0
@@ -148,12 +149,6 @@ def _await_listening(viewer: ViewerProcess, web: bool) -> None:
 
 def stop_viewer(viewer: ViewerProcess) -> None:
     """Stop the viewer (SIGTERM, then SIGKILL after 5 s)."""
-    if viewer.process.poll() is None:
-        viewer.process.terminate()
-        try:
-            viewer.process.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            viewer.process.kill()
-            viewer.process.wait()
+    stop_processes([viewer.process], grace_s=5.0)
     if viewer.temporary_log:
         shutil.rmtree(viewer.log.parent, ignore_errors=True)

@@ -1,0 +1,32 @@
+"""Stopping children: SIGTERM to all, SIGKILL to whoever ignores it after the grace period,
+and every one waited for."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import pytest
+
+from mission.procs.stopping import stop_processes
+
+pytestmark = pytest.mark.slow  # starts processes
+
+STUBBORN = (
+    "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); "
+    "print(1, flush=True); time.sleep(60)"
+)
+
+
+def test_a_stubborn_child_is_killed_after_the_grace_and_a_polite_one_at_once():
+    polite = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    stubborn = subprocess.Popen([sys.executable, "-c", STUBBORN], stdout=subprocess.PIPE)
+    stubborn.stdout.readline()  # its handler is in place
+    done = subprocess.Popen([sys.executable, "-c", "pass"])
+    done.wait()
+    start = time.monotonic()
+    stop_processes([polite, stubborn, done], grace_s=1.0)
+    took = time.monotonic() - start
+    assert polite.returncode == -15 and stubborn.returncode == -9 and done.returncode == 0
+    assert 0.9 < took < 10
