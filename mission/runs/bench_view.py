@@ -6,10 +6,10 @@ import json
 import signal
 import statistics
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
+from mission.procs.commands import mission_run_argv
 from mission.runs.bench_result import BenchResult
 
 MAX_SLOWDOWN = 0.10  # the issue's bound: at most 10 % slower with the live view
@@ -37,7 +37,7 @@ def bench_view(repeats: int = 5) -> list[BenchResult]:
 def _wall(out: Path, view: bool) -> float:
     """The wall time of one run; with the view, the viewer is stopped (Ctrl-C) once the run
     is over and it says so."""
-    command = [sys.executable, "-m", "mission", "run", "along", "--seed", "0", "--out", str(out)]
+    command = mission_run_argv("along", out)
     if not view:
         subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
         return json.loads((out / "summary.json").read_text())["wall_time_s"]

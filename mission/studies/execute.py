@@ -10,7 +10,6 @@ import json
 import shutil
 import socket
 import subprocess
-import sys
 import tarfile
 from pathlib import Path
 from typing import Any, Literal
@@ -20,6 +19,7 @@ import yaml
 from mission.config.scenario import resolved_mapping
 from mission.procs.atomic import write_text_atomically
 from mission.procs.cli_common import child_environment
+from mission.procs.commands import mission_run_argv
 from mission.studies.runkeys import StudyRun
 
 Keep = Literal["all", "logs", "summary"]
@@ -39,21 +39,9 @@ def prepare(run: StudyRun, run_dir: Path) -> None:
 def start(run: StudyRun, run_dir: Path, mpc_helper: bool) -> subprocess.Popen:
     """``mission run`` of the prepared folder, its output in ``mission.log``; it dies with
     this process."""
-    command = [
-        sys.executable,
-        "-m",
-        "mission",
-        "run",
-        str(run_dir / SCENARIO_FILE),
-        "--method",
-        run.method,
-        "--seed",
-        str(run.seed),
-        "--out",
-        str(run_dir),
-        "--mpc-helper" if mpc_helper else "--no-mpc-helper",
-        "--exit-with-parent",
-    ]
+    command = mission_run_argv(
+        run_dir / SCENARIO_FILE, run_dir, run.method, run.seed, mpc_helper, ["--exit-with-parent"]
+    )
     if run.speedup is not None:
         command += ["--realtime", "--speedup", str(run.speedup)]
     with (run_dir / "mission.log").open("w") as log:
