@@ -17,6 +17,7 @@ from typing import Any, TextIO
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.procs.cli_common import child_environment
 from mission.procs.commands import mission_run_argv
 from mission.procs.machine_speed import python_loop_s
 from mission.procs.stopping import stop_processes
@@ -306,8 +307,8 @@ def run_as_command(
     (a fresh process: this one may have threads that keep it from forking vehicles)."""
     import json
 
-    command = mission_run_argv(scenario, out, method, 0, mpc_helper)
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    command = mission_run_argv(scenario, out, method, 0, mpc_helper, ["--exit-with-parent"])
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=child_environment())
     return json.loads((out / "summary.json").read_text())
 
 

@@ -9,6 +9,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from mission.procs.cli_common import child_environment
 from mission.procs.commands import mission_run_argv
 from mission.runs.bench_result import BenchResult
 
@@ -37,11 +38,13 @@ def bench_view(repeats: int = 5) -> list[BenchResult]:
 def _wall(out: Path, view: bool) -> float:
     """The wall time of one run; with the view, the viewer is stopped (Ctrl-C) once the run
     is over and it says so."""
-    command = mission_run_argv("along", out)
+    command = mission_run_argv("along", out, extra=["--exit-with-parent"])  # a killed bench
     if not view:
-        subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+        subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=child_environment())
         return json.loads((out / "summary.json").read_text())["wall_time_s"]
-    process = subprocess.Popen([*command, "--view", "web"], stdout=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        [*command, "--view", "web"], stdout=subprocess.PIPE, text=True, env=child_environment()
+    )
     try:
         for line in process.stdout:  # the run is over when it says where the viewer stays
             if line.startswith("viewer at "):
