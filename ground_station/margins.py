@@ -142,22 +142,23 @@ class Margins:
         """The least sum of the steps' slacks of a path that ends within d_max of ``terminal``
         (each step u of U then within (U - u) d_max of it, u from 0): where a half-space
         lies beyond that ball, its step must break it by at least the gap."""
-        horizon = len(parameters) // (4 * self.slots)
-        count = horizon * self.slots
-        normals = parameters[: 3 * count].reshape(horizon, self.slots, 3)
-        offsets = parameters[3 * count :].reshape(horizon, self.slots)
+        normals, offsets = self._unpack(parameters)
+        horizon = len(offsets)
         radius = (horizon - np.arange(horizon)) * d_max * (1 + 1e-6)  # the bounds' tolerance
         gap = offsets - normals @ np.asarray(terminal, dtype=float) - radius[:, None]
         return float(np.maximum(gap.max(axis=1), 0.0).sum())
 
     def slack_guess(self, guess: np.ndarray, parameters: np.ndarray) -> np.ndarray:
         """Each step's largest violation at the guess (the slacks' starting point)."""
-        horizon = len(guess)
-        count = horizon * self.slots
-        normals = parameters[: 3 * count].reshape(horizon, self.slots, 3)
-        offsets = parameters[3 * count :].reshape(horizon, self.slots)
+        normals, offsets = self._unpack(parameters)
         violation = offsets - np.einsum("usk,uk->us", normals, guess)
         return np.maximum(violation.max(axis=1), 0.0)
+
+    def _unpack(self, parameters: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The (U, slots, 3) normals and (U, slots) offsets of :meth:`parameters`' output."""
+        count = len(parameters) // 4
+        normals = parameters[: 3 * count].reshape(-1, self.slots, 3)
+        return normals, parameters[3 * count :].reshape(-1, self.slots)
 
 
 def _dot(a, b) -> float:

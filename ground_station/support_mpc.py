@@ -263,10 +263,13 @@ class SupportMpc:
         """A lower bound of near's cost from its margins' slacks (0 without margins)."""
         if not self.margins.slots:
             return 0.0
-        count = self.horizon * self.margins.slots * 4
         return MARGIN_WEIGHT * self.margins.least_slack(
-            terminal, self.control.d_max_support_m, flags[-count:]
+            terminal, self.control.d_max_support_m, self._margin_flags(flags)
         )
+
+    def _margin_flags(self, flags: np.ndarray) -> np.ndarray:
+        """The margins' parameters, the last of the flags."""
+        return flags[len(flags) - self.horizon * self.margins.slots * 4 :]
 
     def _solve_branch(self, fixed, flags, guess, branch: str):
         """One branch's solve from ``guess``: (path, casadi's status, true cost)."""
@@ -275,8 +278,8 @@ class SupportMpc:
         weight = c.w_interval if branch == "near" else c.w_penalty
         x0 = guess.ravel()
         if self.margins.slots:  # the slacks start at each step's violation of its margins
-            count = self.horizon * self.margins.slots * 4
-            x0 = np.concatenate([x0, self.margins.slack_guess(guess, flags[-count:]) + 1e-3])
+            slacks = self.margins.slack_guess(guess, self._margin_flags(flags))
+            x0 = np.concatenate([x0, slacks + 1e-3])
         result = solver(
             x0=x0,
             p=np.concatenate([fixed, [weight], flags]),

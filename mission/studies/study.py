@@ -89,7 +89,8 @@ def run_study(
 
     def done(run: StudyRun, summary: dict | None, wall: float) -> None:
         nonlocal last_report
-        name = run.folder if len(spec.points) == 1 else f"{run.folder} [{_label(run)}]"
+        point = spec.points[run.point].label
+        name = run.folder if len(spec.points) == 1 else f"{run.folder} [{point}]"
         if summary is None:
             failed.append(run.folder)
             bar.advance(f"{name}: FAILED (see {runs_dir / run.folder})")
@@ -143,11 +144,6 @@ def _one_line(summary: dict[str, Any]) -> str:
         f"{done}, {summary['multipath_steps_total']} steps in multipath, "
         f"wall {summary['wall_time_s']:.1f} s"
     )
-
-
-def _label(run: StudyRun) -> str:
-    """The run's point: ``key=value, ...`` (``defaults`` for none)."""
-    return ", ".join(f"{k}={v}" for k, v in run.overrides.items()) or "defaults"
 
 
 def duration_note(runs: int, cores: int | None) -> str | None:

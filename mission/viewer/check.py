@@ -6,16 +6,13 @@ what is not whole yet; a finished run has no such excuse."""
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import numpy as np
 
 from mission.analysis.metrics import scan_records
 from mission.config.errors import InputError
-from mission.viewer.tail import VIEWED_IDS
-
-_SNAPSHOT = re.compile(r"^G_(\d+|initial|final)\.npy$")
+from mission.viewer.tail import SNAPSHOT_NAME, VIEWED_IDS
 
 
 def check_run_files(run_dir: Path, map_shape: tuple[int, ...], recorded: dict) -> list[str]:
@@ -69,7 +66,7 @@ def _check_snapshots(g_dir: Path, shape: tuple[int, ...]) -> None:
     if not g_dir.is_dir():
         return
     for path in sorted(g_dir.iterdir()):
-        if not _SNAPSHOT.match(path.name):
+        if not SNAPSHOT_NAME.match(path.name):
             continue
         try:
             values = np.load(path, allow_pickle=False)

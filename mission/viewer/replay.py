@@ -4,12 +4,12 @@ or the web viewer on 127.0.0.1) and/or a recording file."""
 from __future__ import annotations
 
 import os
-import signal
 import sys
 from pathlib import Path
 from typing import Literal
 
 from mission.config.settings import Scenario
+from mission.procs.interrupts import StopRequest
 from mission.viewer.feed import RunFeed
 from mission.viewer.process import ViewerProcess, start_viewer, stop_viewer
 
@@ -51,18 +51,8 @@ def wait_for_viewer(process: ViewerProcess) -> None:
     where = process.web_url or "the native viewer's window"
     print(f"viewer at {where} (Ctrl-C to stop)", flush=True)
     # Ctrl-C and SIGTERM end the wait, even where SIGINT was ignored (a background job)
-    previous = {
-        signal.SIGTERM: signal.signal(signal.SIGTERM, _interrupt),
-        signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
-    }
     try:
-        process.process.wait()
+        with StopRequest():
+            process.process.wait()
     except KeyboardInterrupt:
         print("viewer stopped", file=sys.stderr)
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
-
-
-def _interrupt(*_: object) -> None:
-    raise KeyboardInterrupt

@@ -31,7 +31,7 @@ VIEWED_IDS = frozenset(
 )
 STATION_SYSTEM_ID = 255  # the ground station's packets (requests, commands) are skipped
 SYSTEM_TIME_ID = mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME
-_SNAPSHOT = re.compile(r"^G_(\d+|initial|final)\.npy$")
+SNAPSHOT_NAME = re.compile(r"^G_(\d+|initial|final)\.npy$")  # g/ files of G
 
 
 class TlogTail:
@@ -115,7 +115,7 @@ class SnapshotTail:
             return []
         found = []
         for name in names:
-            match = _SNAPSHOT.match(name)
+            match = SNAPSHOT_NAME.match(name)
             if match is None or name in self._done:
                 continue
             label = match.group(1)
