@@ -43,3 +43,30 @@ def test_a_stopped_run_says_why_and_every_run_says_how_close_it_came():
     line = run_line(summary, 900.0)
     assert line.startswith("STOPPED: support-1 crashed at 22.5 s;")
     assert line.endswith("; closest approach 2.85 m, least clearance 0.54 m")
+
+
+def test_real_time_at_1x_says_so_and_a_chosen_speed_up_does_not(capsys):
+    from argparse import Namespace
+
+    from mission.subcommands import realtime_speedup
+
+    assert realtime_speedup(Namespace(realtime=True, speedup=None)) == 1.0
+    assert "real time at 1x" in capsys.readouterr().err
+    assert realtime_speedup(Namespace(realtime=True, speedup=10.0)) == 10.0
+    assert capsys.readouterr().err == ""
+
+
+def test_the_bench_names_each_group_as_it_goes(monkeypatch):
+    import io
+
+    from mission.runs import bench
+    from mission.runs.bench_result import BenchResult
+
+    row = BenchResult("made_up", 1.0, "x", "reference", None)
+    monkeypatch.setattr(bench, "BENCHMARKS", {"quick": lambda: [row], "other": lambda: []})
+    progress = io.StringIO()
+    results = bench.run_benchmarks(["quick"], progress)
+    assert results[1:] == [row]
+    lines = progress.getvalue().splitlines()
+    assert lines[0] == "bench: quick ..." and lines[1].startswith("bench: quick done in ")
+    assert len(lines) == 2  # the group not asked for is not run
