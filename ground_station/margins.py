@@ -138,14 +138,18 @@ class Margins:
             normal.append(normals)
         return distance, closest, normal
 
-    def least_slack(self, terminal: np.ndarray, d_max: float, parameters: np.ndarray) -> float:
-        """The least sum of the steps' slacks of a path that ends within d_max of ``terminal``
-        (each step u of U then within (U - u) d_max of it, u from 0): where a half-space
-        lies beyond that ball, its step must break it by at least the gap."""
+    def least_slack(
+        self, centre: np.ndarray, d_max: float, parameters: np.ndarray, from_start: bool = False
+    ) -> float:
+        """The least sum of the steps' slacks of a path that ends within d_max of ``centre``
+        (each step u of U then within (U - u) d_max of it, u from 0), or with
+        ``from_start``, that starts at ``centre`` (step u within (u + 1) d_max of it): where
+        a half-space lies beyond its step's ball, the step must break it by at least the gap."""
         normals, offsets = self._unpack(parameters)
         horizon = len(offsets)
-        radius = (horizon - np.arange(horizon)) * d_max * (1 + 1e-6)  # the bounds' tolerance
-        gap = offsets - normals @ np.asarray(terminal, dtype=float) - radius[:, None]
+        steps = np.arange(1, horizon + 1) if from_start else horizon - np.arange(horizon)
+        radius = steps * d_max * (1 + 1e-6)  # the bounds' tolerance
+        gap = offsets - normals @ np.asarray(centre, dtype=float) - radius[:, None]
         return float(np.maximum(gap.max(axis=1), 0.0).sum())
 
     def slack_guess(self, guess: np.ndarray, parameters: np.ndarray) -> np.ndarray:

@@ -4,6 +4,8 @@ the deck, and the work UAV waits rather than step into a margin."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import trimesh
@@ -12,6 +14,7 @@ from ground_station.margins import SLOTS, Margins
 from ground_station.models import build_models
 from ground_station.plan import plan, work_must_wait
 from ground_station.support_mpc import CONVERGED, SupportMpc
+from ground_station.support_nlp import SOFT
 from ground_station.work_mpc import predict_work
 from mission.config.scenario import load_scenario
 from mission.link.plan_files import read_plan
@@ -179,3 +182,79 @@ def test_near_is_not_solved_where_far_beats_what_its_slacks_must_cost(worlds, mo
     control = safe.scenario.control
     apart = np.linalg.norm(kept.path - parked, axis=1).min()
     assert apart >= control.min_separation_m + 2 * control.estimate_allowance_m - 1e-3
+
+
+def _forms_solved(monkeypatch) -> list[str]:
+    """The solver forms (branch, or branch + SOFT) every solve of the test uses, in order."""
+    solved: list[str] = []
+    solve_form = SupportMpc._solve_form
+
+    def counted(self, fixed, flags, guess, branch, form):
+        solved.append(form)
+        return solve_form(self, fixed, flags, guess, branch, form)
+
+    monkeypatch.setattr(SupportMpc, "_solve_form", counted)
+    return solved
+
+
+def test_the_hard_form_is_solved_where_the_margins_can_be_kept_and_has_the_soft_ones_minimum(
+    worlds, monkeypatch
+):
+    """The squeezed support can keep its margins: its plan comes from the hard form alone, and
+    the soft form (the exact penalty), solved from the same start, finds the same path."""
+    safe, _ = worlds
+    mpc = _mpc(safe, 3)
+    solved = _forms_solved(monkeypatch)
+    kept, _ = _squeezed(safe, mpc)
+    assert kept.status == CONVERGED and solved and not any(f.endswith(SOFT) for f in solved)
+    monkeypatch.setattr(SupportMpc, "_may_keep_margins", lambda *arguments: False)
+    soft, _ = _squeezed(safe, mpc)
+    assert soft.status == CONVERGED and all(f.endswith(SOFT) for f in solved[-2:])
+    np.testing.assert_allclose(soft.path, kept.path, atol=5e-3)
+
+
+def test_a_margin_out_of_reach_goes_straight_to_the_soft_form(worlds, monkeypatch):
+    """Another UAV parked on the support's own estimate: the first step cannot leave its
+    margin (3.5 m away, 1 m a step), so no hard form is tried, and the plan breaks the margin
+    no more than it must (it flies straight away from the other UAV)."""
+    safe, _ = worlds
+    mpc = _mpc(safe, 3)
+    plan_ = read_plan(safe.scenario)
+    horizon = safe.scenario.control.horizon_steps
+    yhat = np.array([-6.0, 12.0, 8.5])  # in the open, beside the bridge
+    work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
+    waypoints = np.repeat([yhat], 15, axis=0)
+    parked = np.repeat([yhat + [0.0, -0.5, 0.0]], horizon, axis=0)
+    others = np.array([work.path[:horizon], parked, parked + [0.0, 30.0, 0.0]])
+    request = mpc.request(
+        "support-1", yhat, waypoints, work.path, work.indices, safe.sigma0_map().sigma_m,
+        others=others,
+    )  # fmt: skip
+    solved = _forms_solved(monkeypatch)
+    planned = mpc.plan(request, safe.camera.observable)
+    assert planned.status == CONVERGED and solved and all(f.endswith(SOFT) for f in solved)
+    distance = np.linalg.norm(planned.path - parked, axis=1)
+    assert distance[0] > 0.5 + 0.9  # close to a full step straight away
+
+
+def test_a_failed_hard_solve_falls_back_to_the_soft_form(worlds, monkeypatch):
+    """When the hard form does not converge, the same branch is solved in its soft form, and
+    the plan is the soft form's."""
+    safe, _ = worlds
+    mpc = _mpc(safe, 3)
+    solved = _forms_solved(monkeypatch)
+    solve_form = SupportMpc._solve_form  # the counting one
+
+    def hard_fails(self, fixed, flags, guess, branch, form):
+        path, status, cost = solve_form(self, fixed, flags, guess, branch, form)
+        return (
+            (path, "SOLVER_RET_LIMITED", cost) if not form.endswith(SOFT) else (path, status, cost)
+        )
+
+    monkeypatch.setattr(SupportMpc, "_solve_form", hard_fails)
+    planned, _ = _squeezed(safe, mpc)
+    assert planned.status == CONVERGED
+    assert [f for f in solved if not f.endswith(SOFT)]  # tried hard first
+    for hard, after in itertools.pairwise(solved):
+        if not hard.endswith(SOFT):
+            assert after == hard + SOFT
