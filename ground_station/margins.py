@@ -22,6 +22,9 @@ import math
 
 import numpy as np
 
+from ground_station.casadi_buffer import BufferedFunction
+from ground_station.margin_spaces import SpaceRules, half_spaces_function
+from ground_station.nlp_cache import compiled_function
 from mission.config.settings import ControlSettings
 from mission.world.proximity import StructureProximity
 from mission.world.structure import Structure
@@ -34,7 +37,9 @@ UNUSED: Space = ((0.0, 0.0, 0.0), -1.0)  # a slot no half-space fills
 class Margins:
     """The half-spaces of one support MPC's steps, with a fixed number of slots per step."""
 
-    def __init__(self, control: ControlSettings, structure: Structure, others: int) -> None:
+    def __init__(
+        self, control: ControlSettings, structure: Structure, others: int, compiled: bool = True
+    ) -> None:
         allowance = control.estimate_allowance_m  # the plans are made on estimates
         self.separation = control.min_separation_m
         self.clearance = control.clearance_m
@@ -52,6 +57,28 @@ class Margins:
             (low.tolist(), high.tolist())
             for low, high in zip(self.proximity.low, self.proximity.high, strict=True)
         ]
+        self._horizon = control.horizon_steps
+        self._function = self._compiled(compiled)
+
+    def _compiled(self, compiled: bool) -> BufferedFunction | None:
+        """The half-spaces as a casadi function (:mod:`ground_station.margin_spaces`), compiled
+        where a C compiler is there and ``compiled`` asks for it; None where it does not apply
+        (no margins, or a mesh file among the pieces)."""
+        if self.slots == 0 or (self.clearance > 0 and self.proximity.has_file_mesh):
+            return None
+        rules = SpaceRules(
+            self.separation,
+            self.clearance,
+            self._reach_m,
+            self.proximity.low,
+            self.proximity.high,
+            self.other_slots,
+            self.slots,
+        )
+        function = half_spaces_function(rules, self._horizon)
+        if compiled:
+            function = compiled_function(function)
+        return BufferedFunction(function, ("spaces", "inside"))
 
     def parameters(self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray) -> np.ndarray:
         """The NLP's margin parameters for a guess (U, 3): every step's normals (column by
@@ -65,8 +92,13 @@ class Margins:
         numpy's per-call overhead makes it take (86 against 176 us on Along's problems)."""
         if self.slots == 0:
             return np.zeros(0)
+        others = np.asarray(others, dtype=float)[: self.other_slots]
+        if self._function is not None and others.shape == (self.other_slots, self._horizon, 3):
+            found = self._function(guess=np.ravel(guess), yhat=yhat, others=others.ravel())
+            if found["inside"][0] == 0:
+                return found["spaces"]
         points = np.asarray(guess, dtype=float).tolist()
-        others = np.asarray(others, dtype=float)[: self.other_slots].tolist()
+        others = others.tolist()
         pieces = self._pieces(guess) if self.clearance > 0 else [[] for _ in points]
         start = np.asarray(yhat, dtype=float).tolist()
         normals: list[float] = []

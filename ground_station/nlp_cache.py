@@ -38,12 +38,42 @@ class NlpBuild:
     nlp: dict[str, ca.MX]
     options: dict
 
+    def recipe(self) -> str:
+        """What the library is made from (its cache key hashes it)."""
+        nlp = self.nlp
+        functions = ca.Function("nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
+        options = repr(sorted(self.options.items()))
+        return "\n".join([self.name, self.plugin, options, functions.serialize()])
 
-def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> list[str | None]:
-    """For each build, the functions its casadi solver needs, compiled into a shared library
-    with the system C compiler (about 4x faster plans than interpreting them), or None
-    without one. The libraries not yet cached are compiled at the same time, one compiler
-    process each.
+    def generate(self, source: str) -> None:
+        """Write the C of the functions the solver evaluates to ``source`` (working directory)."""
+        solver = ca.nlpsol(self.name, self.plugin, self.nlp, self.options)
+        solver.generate_dependencies(source)
+
+
+@dataclass(frozen=True)
+class FunctionBuild:
+    """One casadi Function to compile (load the library with ``ca.external(function.name(),
+    library)``)."""
+
+    function: ca.Function
+
+    def recipe(self) -> str:
+        """What the library is made from (its cache key hashes it)."""
+        return "\n".join(["function", self.function.serialize()])
+
+    def generate(self, source: str) -> None:
+        """Write the function's C to ``source`` (working directory)."""
+        self.function.generate(source)
+
+
+def compiled_nlps(
+    builds: list[NlpBuild | FunctionBuild], fallback_dir: Callable[[], str]
+) -> list[str | None]:
+    """For each build, the functions its casadi solver needs (or the function), compiled into
+    a shared library with the system C compiler (about 4x faster plans than interpreting
+    them), or None without one. The libraries not yet cached are compiled at the same time,
+    one compiler process each.
 
     A library is cached (under ``$XDG_CACHE_HOME`` or ``~/.cache``) by the hash of the
     serialised NLP, the solver's name, plugin and options, the casadi version, the compiler
@@ -70,11 +100,9 @@ def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> li
     with tempfile.TemporaryDirectory(prefix="support-mpc-c-") as scratch:
         sources: dict[int, tuple[str, Path]] = {}
         for index, library_name in missing.items():
-            build = builds[index]
-            solver = ca.nlpsol(build.name, build.plugin, build.nlp, build.options)
             source = f"support_mpc_nlp{index}.c"  # its stem must be a C identifier
             with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
-                solver.generate_dependencies(source)
+                builds[index].generate(source)
             sources[index] = (library_name, Path(scratch) / source)
         for directory_of in (_cache_dir, lambda: Path(fallback_dir())):
             if not sources:
@@ -91,6 +119,19 @@ def compiled_nlps(builds: list[NlpBuild], fallback_dir: Callable[[], str]) -> li
     return libraries
 
 
+def compiled_function(function: ca.Function) -> ca.Function:
+    """``function`` compiled (and cached) and loaded, or itself, interpreted, without a C
+    compiler."""
+    with contextlib.ExitStack() as scratch:  # for a library the cache cannot take
+
+        def private_directory() -> str:
+            return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
+
+        (library,) = compiled_nlps([FunctionBuild(function)], private_directory)
+        # loaded, the library's file may go
+        return function if library is None else ca.external(function.name(), library)
+
+
 COMPILING = "compiling the support MPC"  # what `mission run` shows of a first run's wait
 COMPILED = "compiled the support MPC"
 
@@ -104,18 +145,8 @@ def c_compiler() -> str | None:
     return shutil.which("gcc") or shutil.which("cc")
 
 
-def _library_name(compiler: str, build: NlpBuild) -> str:
-    nlp = build.nlp
-    functions = ca.Function("nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
-    recipe = "\n".join(
-        [
-            f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}",
-            build.name,
-            build.plugin,
-            repr(sorted(build.options.items())),
-            functions.serialize(),
-        ]
-    )
+def _library_name(compiler: str, build: NlpBuild | FunctionBuild) -> str:
+    recipe = f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}\n{build.recipe()}"
     return f"support_mpc_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
 
 

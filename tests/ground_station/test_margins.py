@@ -258,3 +258,31 @@ def test_a_failed_hard_solve_falls_back_to_the_soft_form(worlds, monkeypatch):
     for hard, after in itertools.pairwise(solved):
         if not hard.endswith(SOFT):
             assert after == hard + SOFT
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_half_spaces_function_gives_the_python_values_bit_for_bit(compiled):
+    """The casadi function (compiled, or interpreted) against the plain-float definition, to
+    the last bit, on random guesses with steps on other UAVs, on yhat too, and inside the deck
+    (where it hands over to Python): the plans, and so the records, cannot change."""
+    world = World(load_scenario("along"))
+    control = world.scenario.control
+    fast = Margins(control, world.structure, others=3, compiled=compiled)
+    python = Margins(control, world.structure, others=3)
+    python._function = None
+    assert fast._function is not None
+    rng = np.random.default_rng(7)
+    deck = world.structure.boxes[0]
+    for trial in range(400):
+        guess = rng.uniform([-15, -10, 0.2], [15, 10, 12], (5, 3))
+        yhat = rng.uniform([-15, -10, 0.2], [15, 10, 12])
+        others = rng.uniform([-15, -10, 0.2], [15, 10, 12], (3, 5, 3))
+        if trial % 4 == 1:  # a step on another UAV
+            others[1, 3] = guess[3]
+        if trial % 8 == 3:  # ... and yhat too
+            others[2, 0] = guess[0]
+            yhat = guess[0].copy()
+        if trial % 10 == 5:  # a step inside the deck
+            guess[2] = rng.uniform(deck.min_m, deck.max_m)
+        ours = fast.parameters(guess, yhat, others)
+        assert np.array_equal(ours, python.parameters(guess, yhat, others)), trial
