@@ -12,7 +12,7 @@ from mission.procs.atomic import write_text_atomically
 from mission.studies.report_figures import write_figures
 from mission.studies.results import metric_values, paired
 from mission.studies.spec import StudySpec
-from mission.studies.stats import bootstrap_ci, mean_ci, wilcoxon_p
+from mission.studies.stats import WILCOXON_METHOD, bootstrap_ci, mean_ci, wilcoxon_p
 
 # (column, what it is); completion time over completed runs only
 METRICS = (
@@ -49,6 +49,7 @@ def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) 
     ]
     if set(spec.methods) == {"ac", "nac"}:
         lines += ["", "## AC against NAC, paired by seed", "", *_paired_table(spec, rows)]
+        lines += ["", f"p: the {WILCOXON_METHOD}."]
     if figures:
         lines += ["", "## Figures", ""]
         lines += [f"![{path.stem}](figures/{path.name})" for path in figures]

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from mission.procs.atomic import write_atomically, write_text_atomically
-from mission.studies.stats import wilcoxon_p
+from mission.studies.stats import WILCOXON_METHOD, wilcoxon_p
 
 
 @dataclass(frozen=True)
@@ -117,6 +117,7 @@ def table_markdown(table: list[dict]) -> str:
             f"| {_reduction(r['steps_reduction_pct'], r['steps_wilcoxon_p'], r['pairs'])} "
             f"| {_reduction(r['time_reduction_pct'], r['time_wilcoxon_p'], r['time_pairs'])} |"
         )
+    lines += ["", f"p: the {WILCOXON_METHOD}."]
     return "\n".join(lines) + "\n"
 
 
