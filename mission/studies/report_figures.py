@@ -46,6 +46,7 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     values = list(dict.fromkeys(p.as_dict().get(key) for p in spec.points))
     numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
     positions = {v: (v if numeric else i) for i, v in enumerate(values)}
+    varying = _varying_keys(spec)
     figure, axes = plt.subplots(
         len(metrics),
         len(scenarios),
@@ -55,9 +56,9 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     for column_index, scenario in enumerate(scenarios):
         for row_index, (column, label) in enumerate(metrics):
             axis = axes[row_index][column_index]
-            for (rest, method), points in _lines(spec, key).items():
+            for (rest, method), points in _lines(spec, key, varying).items():
                 xs, ys, errors = [], [], []
-                for number, value in points:
+                for number, value in sorted(points, key=lambda point: positions[point[1]]):
                     mine = [
                         r
                         for r in rows
@@ -73,8 +74,10 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
                 if xs:
                     name = method.upper() + (f", {rest}" if rest else "")
                     axis.errorbar(xs, ys, yerr=errors, marker="o", capsize=3, label=name)
-            if not numeric:
-                axis.set_xticks(range(len(values)), [str(v) for v in values])
+            if not numeric:  # a point that does not set the key flies the scenario's default
+                axis.set_xticks(
+                    range(len(values)), ["default" if v is None else str(v) for v in values]
+                )
             axis.set_xlabel(key)
             axis.set_ylabel(label, fontsize=8)
             axis.grid(alpha=0.3)
@@ -103,12 +106,21 @@ def _scalar(value: object) -> bool:
     return value is None or isinstance(value, str | int | float | bool)
 
 
-def _lines(spec: StudySpec, key: str) -> dict[tuple[str, str], list[tuple[int, object]]]:
-    """{(the other keys' values, method): [(point number, this key's value), ...]}."""
+def _varying_keys(spec: StudySpec) -> set[str]:
+    """The keys whose value is not the same in every point (the others name no line)."""
+    settings = [point.as_dict() for point in spec.points]
+    keys = {key for overrides in settings for key in overrides}
+    return {key for key in keys if len({repr(s.get(key)) for s in settings}) > 1}
+
+
+def _lines(
+    spec: StudySpec, key: str, varying: set[str]
+) -> dict[tuple[str, str], list[tuple[int, object]]]:
+    """{(the other varying keys' values, method): [(point number, this key's value), ...]}."""
     lines: dict[tuple[str, str], list[tuple[int, object]]] = {}
     for number, point in enumerate(spec.points):
         overrides = point.as_dict()
-        rest = ", ".join(f"{k}={v}" for k, v in point.overrides if k != key)
+        rest = ", ".join(f"{k}={v}" for k, v in point.overrides if k != key and k in varying)
         for method in spec.methods:
             lines.setdefault((rest, method), []).append((number, overrides.get(key)))
     return lines

@@ -1,0 +1,57 @@
+"""The report's figures read right: each line runs left to right, the legend names a line by
+the keys that tell it apart, and a point that does not set the swept key says "default"."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import pytest
+
+from mission.studies import report_figures
+from mission.studies.spec import Point, StudySpec
+from mission.studies.study import run_study
+from tests.studies.test_study import FakeEngine
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures as drawn, by file name (not saved)."""
+    figures = {}
+
+    def keep(figure, path):
+        figures[Path(path).name] = figure
+
+    monkeypatch.setattr(report_figures, "save_figure", keep)
+    return figures
+
+
+def _study(tmp_path, points) -> None:
+    spec = StudySpec("t", "", Path("t.yaml"), ("along",), ("ac", "nac"), (0, 1), points, ())
+    run_study(spec, tmp_path, FakeEngine(), progress=io.StringIO())
+
+
+def test_lines_run_in_order_of_the_swept_value_and_are_named_by_what_varies(tmp_path, drawn):
+    fixed = ("run.stop_on_crash", False)
+    points = tuple(
+        Point((("control.clearance_m", clearance), ("control.min_separation_m", separation), fixed))
+        for clearance, separation in ((1.0, 2), (0.0, 2), (0.5, 2), (0.5, 0))
+    )  # fmt: skip
+    _study(tmp_path, points)
+    figure = drawn["metrics-vs-control.clearance_m.png"]
+    axis = figure.axes[0]
+    for line in axis.get_lines():
+        xs = list(line.get_xdata())
+        assert xs == sorted(xs)
+    handles, names = axis.get_legend_handles_labels()  # errorbar containers: [0] the line
+    lines = {name: list(handle[0].get_xdata()) for handle, name in zip(handles, names, strict=True)}
+    assert lines["AC, control.min_separation_m=2"] == [0.0, 0.5, 1.0]
+    labels = [text.get_text() for legend in figure.legends for text in legend.get_texts()]
+    assert labels and not any("stop_on_crash" in label for label in labels)
+
+
+def test_a_point_that_does_not_set_the_key_sits_at_default(tmp_path, drawn):
+    points = (Point(()), Point((("control.escape_starts", False),)))
+    _study(tmp_path, points)
+    axis = drawn["metrics-vs-control.escape_starts.png"].axes[0]
+    assert [tick.get_text() for tick in axis.get_xticklabels()] == ["default", "False"]
