@@ -100,9 +100,9 @@ def build_parser() -> OneLineArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a mission and print its summary as JSON."""
-    from ground_station.links import StationError
+    from ground_station.links.vehicle_links import StationError
     from ground_station.station import GroundStation, StationConfig
-    from ground_station.support_planning import HelperError
+    from ground_station.support_mpc.sharing import HelperError
 
     args = build_parser().parse_args(argv)
     name_this_process("ground_station")  # forked by `mission run`, it has no own argv

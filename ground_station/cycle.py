@@ -26,12 +26,12 @@ import numpy as np
 from ground_station.align import align
 from ground_station.arrival import check_arrival
 from ground_station.fusion import FusionResult, SupportMeasurement, fuse
-from ground_station.localizability import learn
+from ground_station.gnss_map import learn
 from ground_station.localize import SupportReport, localize
-from ground_station.models import Models
 from ground_station.plan import FormationPlan, plan, solve_supports
+from ground_station.run_context import RunContext
 from ground_station.state import StationState
-from ground_station.support_mpc import SupportPlan
+from ground_station.support_mpc.mpc import SupportPlan
 from ground_station.work_mpc import WorkPrediction
 
 
@@ -70,25 +70,27 @@ class CycleOutput:
 
 
 def control_cycle(
-    state: StationState, reports: Sequence[SupportReport], models: Models
+    state: StationState, reports: Sequence[SupportReport], context: RunContext
 ) -> CycleDecision:
     """The paper's five steps for this cycle's reports; updates ``state`` in place."""
     start = time.perf_counter()
-    control = models.scenario.control
-    measurements = localize(align(reports, state, control.t_cont_s), models.world)  # 1
-    fusion, betas = fuse(state, measurements, models.scenario.fusion, models.rng)  # 2
+    control = context.scenario.control
+    measurements = localize(align(reports, state, control.t_cont_s), context.world)  # 1
+    fusion, betas = fuse(state, measurements, context.scenario.fusion, context.rng)  # 2
     blind = fusion.blind  # no waypoint is reached on a dead-reckoned estimate
-    arrived = None if blind else check_arrival(state, models.work_waypoints, control.arrival_tol_m)
-    updated = learn(models.g, measurements, state.yhat)  # 4
-    formation = plan(state, models, [m.name for m in measurements], hold=blind)  # 5
+    arrived = None if blind else check_arrival(state, context.work_waypoints, control.arrival_tol_m)
+    updated = learn(context.g, measurements, state.yhat)  # 4
+    formation = plan(state, context, [m.name for m in measurements], hold=blind)  # 5
     elapsed_ms = (time.perf_counter() - start) * 1000
     return CycleDecision(measurements, fusion, betas, arrived, updated, formation, elapsed_ms)
 
 
-def complete_cycle(state: StationState, decision: CycleDecision, models: Models) -> CycleOutput:
+def complete_cycle(
+    state: StationState, decision: CycleDecision, context: RunContext
+) -> CycleOutput:
     """The supports' MPCs solved: the cycle's commands and record."""
     start = time.perf_counter()
-    plans = solve_supports(state, decision.formation, models)
+    plans = solve_supports(state, decision.formation, context)
     return CycleOutput(
         decision.work_command,
         {name: support_plan.command for name, support_plan in plans.items()},
@@ -102,6 +104,8 @@ def complete_cycle(state: StationState, decision: CycleDecision, models: Models)
     )
 
 
-def run_cycle(state: StationState, reports: Sequence[SupportReport], models: Models) -> CycleOutput:
+def run_cycle(
+    state: StationState, reports: Sequence[SupportReport], context: RunContext
+) -> CycleOutput:
     """A whole cycle with nothing sent in between (the detached run, tests)."""
-    return complete_cycle(state, control_cycle(state, reports, models), models)
+    return complete_cycle(state, control_cycle(state, reports, context), context)

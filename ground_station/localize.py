@@ -52,7 +52,8 @@ class SupportReport:
 
 
 class Sample(Protocol):
-    """A support's messages for a cycle (:class:`ground_station.links.SupportSample`)."""
+    """A support's messages for a cycle
+    (:class:`ground_station.links.vehicle_links.SupportSample`)."""
 
     name: str
     gps: Any | None

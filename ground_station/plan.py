@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.localizability import hermite_zero_slope
-from ground_station.models import Models
+from ground_station.gnss_map import hermite_zero_slope
+from ground_station.run_context import RunContext
 from ground_station.state import StationState, reachable
-from ground_station.support_mpc import PlanRequest, SupportPlan
+from ground_station.support_mpc.mpc import PlanRequest, SupportPlan
 from ground_station.work_mpc import WorkPrediction, hold_work, predict_work
 
 ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape starts too
@@ -30,7 +30,7 @@ class FormationPlan:
 
 
 def plan(
-    state: StationState, models: Models, supports: Sequence[str], hold: bool = False
+    state: StationState, context: RunContext, supports: Sequence[str], hold: bool = False
 ) -> FormationPlan:
     """The work UAV's path from xhat (its command is the first point), for ``supports`` to
     plan around; records the work UAV's commanded displacement in ``state``.
@@ -39,52 +39,52 @@ def plan(
     (:func:`work_must_wait`). ``hold`` (a blind cycle: no support contributed): it holds where
     its last command took it (xhat, dead-reckoned there by the fusion) for the whole horizon, so the
     supports plan around a work UAV that stays put and regain sight of it."""
-    control = models.scenario.control
+    control = context.scenario.control
     if hold:
         work = hold_work(state.xhat, state.k, control.horizon_steps)
     else:
         work = predict_work(
             state.xhat,
             state.k,
-            models.work_waypoints,
+            context.work_waypoints,
             control.horizon_steps,
             control.d_max_work_m,
             control.arrival_tol_m,
         )
-    if not hold and work_must_wait(state, work.command, models):
+    if not hold and work_must_wait(state, work.command, context):
         work = hold_work(state.xhat, state.k, control.horizon_steps)
     reach = control.s_max_work_m_s * control.t_cont_s
     state.last_work_command = reachable(state.xhat, work.command, reach)
     return FormationPlan(work, tuple(supports))
 
 
-def work_must_wait(state: StationState, command: np.ndarray, models: Models) -> bool:
+def work_must_wait(state: StationState, command: np.ndarray, context: RunContext) -> bool:
     """Whether the work UAV's next step would bring it inside a margin it is not already
     inside, closer: within the separation of a support's estimate, or within the clearance
     of the structure or the ground. It then waits for the supports to give way."""
-    control = models.scenario.control
+    control = context.scenario.control
     if control.min_separation_m > 0:
         for yhat in state.yhat.values():
             after = float(np.linalg.norm(command - yhat))
             if after < control.min_separation_m and after < np.linalg.norm(state.xhat - yhat):
                 return True
     if control.clearance_m > 0:
-        proximity = models.support_mpc.margins.proximity
+        proximity = context.support_mpc.margins.proximity
         after, now = proximity.clearance(np.vstack([command, state.xhat]))
         return bool(after < control.clearance_m and after < now)
     return False
 
 
 def solve_supports(
-    state: StationState, formation: FormationPlan, models: Models
+    state: StationState, formation: FormationPlan, context: RunContext
 ) -> dict[str, SupportPlan]:
     """Every support's MPC posed around the work UAV's path and solved (here, or shared with
     the helper process); each plan's commanded displacement and path (the next warm start) go
     into ``state``."""
     work = formation.work
-    requests = [support_request(state, name, work, models) for name in formation.supports]
-    plans = models.planner.plan_all(requests)
-    control = models.scenario.control
+    requests = [support_request(state, name, work, context) for name in formation.supports]
+    plans = context.planner.plan_all(requests)
+    control = context.scenario.control
     reach = control.s_max_support_m_s * control.t_cont_s
     for name, support_plan in plans.items():
         state.last_support_command[name] = reachable(state.yhat[name], support_plan.command, reach)
@@ -93,25 +93,25 @@ def solve_supports(
 
 
 def support_request(
-    state: StationState, name: str, work: WorkPrediction, models: Models
+    state: StationState, name: str, work: WorkPrediction, context: RunContext
 ) -> PlanRequest:
     """One support's MPC problem; with escape starts where G says GNSS is worse than the prior
     map expected."""
     yhat = state.yhat[name]
-    g = models.g
+    g = context.g
     initial = float(hermite_zero_slope(g.initial, g.grid, yhat)[0])
     risen = bool(g.smoothed(yhat)[0] > initial + ESCAPE_MARGIN_M)
-    escape = risen and models.scenario.control.escape_starts
-    return models.support_mpc.request(
+    escape = risen and context.scenario.control.escape_starts
+    return context.support_mpc.request(
         name,
         yhat,
-        models.support_waypoints[name],
+        context.support_waypoints[name],
         work.path,
         work.indices,
         g.values,
         state.warm.get(name),
         escape=escape,
-        others=others_predicted(state, name, work, models.scenario.control.horizon_steps),
+        others=others_predicted(state, name, work, context.scenario.control.horizon_steps),
     )
 
 

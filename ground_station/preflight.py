@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.links import StationError, VehicleLinks, VehicleView
-from ground_station.mission_client import MissionClient, MissionTransferError
-from ground_station.outgoing import GUIDED_AND_ARMED, gcs_heartbeat
+from ground_station.links.mission_client import MissionClient, MissionTransferError
+from ground_station.links.outgoing import GUIDED_AND_ARMED, gcs_heartbeat
+from ground_station.links.vehicle_links import StationError, VehicleLinks, VehicleView
 from mission.link.waypoints import read_waypoints, row_position_enu
 from mission.world.frames import GeodeticFrame
 

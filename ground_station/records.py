@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ground_station.cycle import CycleOutput
-from ground_station.localizability import LocalizabilityMap
+from ground_station.gnss_map import LocalizabilityMap
 from ground_station.state import StationState
 from mission.procs.atomic import write_text_atomically
 

@@ -1,10 +1,11 @@
 """The ground-station process: set up, then one control cycle every t_cont until the work UAV
 reaches its last waypoint or the scenario's timeout.
 
-Its pieces: the links to the vehicles (:mod:`~ground_station.links`) and the clock
-(:mod:`~ground_station.clock`), the messages it sends (:mod:`~ground_station.outgoing`), what
-it writes (:mod:`~ground_station.records`, :mod:`~ground_station.tlog`), the models built once
-per run (:mod:`~ground_station.models`) and the cycle itself (:mod:`~ground_station.cycle`).
+Its pieces: the links to the vehicles (:mod:`~ground_station.links.vehicle_links`) and the
+clock (:mod:`~ground_station.links.clock`), the messages it sends
+(:mod:`~ground_station.links.outgoing`), what it writes (:mod:`~ground_station.records`,
+:mod:`~ground_station.links.tlog`), the run's context built once (the map G, the support MPC:
+:mod:`~ground_station.run_context`) and the cycle itself (:mod:`~ground_station.cycle`).
 """
 
 from __future__ import annotations
@@ -15,17 +16,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ground_station.clock import LockstepTiming, PendingStep, StationClock, await_step
 from ground_station.cycle import CycleDecision, CycleOutput, complete_cycle, control_cycle
-from ground_station.links import VehicleLinks
+from ground_station.links.clock import LockstepTiming, PendingStep, StationClock, await_step
+from ground_station.links.outgoing import (
+    mission_set_current,
+    position_target,
+    vision_position_estimate,
+)
+from ground_station.links.tlog import TlogWriter
+from ground_station.links.vehicle_links import VehicleLinks
 from ground_station.localize import SupportReport, reports_from_messages
-from ground_station.models import Models, build_models, require_known_world
-from ground_station.outgoing import mission_set_current, position_target, vision_position_estimate
 from ground_station.preflight import arm_all, connect, upload_missions
 from ground_station.records import SNAPSHOT_EVERY, RunRecords
+from ground_station.run_context import RunContext, build_run_context, require_known_world
 from ground_station.state import StationState
-from ground_station.support_planning import MpcHelper
-from ground_station.tlog import TlogWriter
+from ground_station.support_mpc.sharing import MpcHelper
 from mission.link.impairment import LinkSettings
 from mission.link.mavlink_udp import Address
 from mission.procs.cli_common import freeze_startup_heap
@@ -85,17 +90,17 @@ class GroundStation:
         )
         self.cycles = 0
         self.stopped: str | None = None  # why the run ended before its task (a crash)
-        self.models: Models | None = None
+        self.context: RunContext | None = None
         self._helper: MpcHelper | None = None
 
     def run(self) -> dict[str, Any]:
         """Connect, upload, arm, then cycle until done or timeout; return a summary."""
         start_wall = time.monotonic()
-        models, state = self._set_up()
-        self.records.snapshot(models.g, "initial")
+        context, state = self._set_up()
+        self.records.snapshot(context.g, "initial")
         self.links.reset_loss_count()
-        completion = self._fly(models, state)
-        self.records.snapshot(models.g, "final")
+        completion = self._fly(context, state)
+        self.records.snapshot(context.g, "final")
         self.tlog.flush()
         self.records.link_stats(self.links.report(self.config.link))
         return {
@@ -107,9 +112,9 @@ class GroundStation:
             "wall_time_s": time.monotonic() - start_wall,
         }
 
-    def _set_up(self) -> tuple[Models, StationState]:
+    def _set_up(self) -> tuple[RunContext, StationState]:
         """The MPC helper started, the vehicles found, their missions uploaded, GUIDED and
-        armed; the models built."""
+        armed; the context built."""
         if self.config.mpc_helper:  # it imports while sigma_0 is computed here
             self._helper = MpcHelper(str(self.config.out_dir))
         sigma0 = self.world.sigma0_map().sigma_m
@@ -124,13 +129,13 @@ class GroundStation:
         waypoints = upload_missions(self.links, self.config.waypoints_dir, self.frame)
         arm_all(self.links, self.timing.retry_wall_s)
         config = self.config
-        self.models, state = build_models(
+        self.context, state = build_run_context(
             self.world, waypoints, config.adaptive, config.seed, self._helper, sigma0
         )
         freeze_startup_heap()
-        return self.models, state
+        return self.context, state
 
-    def _fly(self, models: Models, state: StationState) -> float | None:
+    def _fly(self, context: RunContext, state: StationState) -> float | None:
         """Control cycles until the work UAV completes its task (its time) or the timeout."""
         self.clock.begin_flight()
         pending = self._start_step(self.clock.next_step())
@@ -144,15 +149,15 @@ class GroundStation:
             for name in self.links.supervise(self.config.silence_limit_s, self.clock.step_s):
                 state.forget(name)
             reports = reports_from_messages(self.links.support_samples(), self.frame)
-            decision = control_cycle(state, reports, models)
+            decision = control_cycle(state, reports, context)
             work_step = self._command_work(state, decision)  # it steps while
-            output = complete_cycle(state, decision, models)  # the supports' MPCs are solved
+            output = complete_cycle(state, decision, context)  # the supports' MPCs are solved
             self._command_supports(state, output)
             cycle_time_s = self.clock.time_s
             # the next tick goes out now: the vehicles step while this cycle is written down
             pending = None if state.completed else self._start_step(work_step, work_ticked=True)
             self.links.flush_all()
-            self._record(models, state, output, cycle_time_s, self._ages_ms(reports))
+            self._record(context, state, output, cycle_time_s, self._ages_ms(reports))
             if state.completed:
                 self.links.announce(f"Mission complete at {self.clock.time_s:.1f} s")
                 return self.clock.time_s
@@ -231,7 +236,7 @@ class GroundStation:
 
     def _record(
         self,
-        models: Models,
+        context: RunContext,
         state: StationState,
         output: CycleOutput,
         time_s: float,
@@ -240,13 +245,13 @@ class GroundStation:
         self.records.cycle(state, output, time_s, ages_ms)
         self.cycles += 1
         if self.cycles % SNAPSHOT_EVERY == 0:
-            self.records.snapshot(models.g, f"{self.cycles:05d}")
+            self.records.snapshot(context.g, f"{self.cycles:05d}")
         self.tlog.flush()
 
     def close(self) -> None:
         """Stop the MPC helper; flush and close every file and the socket."""
-        if self.models is not None:
-            self.models.planner.close()
+        if self.context is not None:
+            self.context.planner.close()
         elif self._helper is not None:
             self._helper.close()
         self.tlog.close()

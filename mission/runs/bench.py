@@ -188,7 +188,7 @@ def _interpreted_over_compiled(world, plan, indices=range(2, 12)) -> float:
     one's, on the three supports' problems at ten waypoints (the same plans either way)."""
     import numpy as np
 
-    from ground_station.support_mpc import SupportMpc
+    from ground_station.support_mpc.mpc import SupportMpc
     from ground_station.work_mpc import predict_work
 
     control, grid, sigma0 = world.scenario.control, world.map_grid(), world.sigma0_map().sigma_m
@@ -220,7 +220,7 @@ def _interpreted_over_compiled(world, plan, indices=range(2, 12)) -> float:
 def _scipy_over_casadi(world, plan, problems: int) -> float:
     """Median time ratio SLSQP / our solver on the same support-MPC problems (optima within
     1 cm)."""
-    from ground_station.support_mpc import SupportMpc
+    from ground_station.support_mpc.mpc import SupportMpc
 
     mpc = SupportMpc(world.scenario.control, world.map_grid(), world.camera)
     g = world.sigma0_map().sigma_m
@@ -234,7 +234,7 @@ def _scipy_over_casadi_once(world, plan, mpc, g, i: int) -> float | None:
     import numpy as np
     from scipy.optimize import minimize
 
-    from ground_station.support_cost import support_cost_numpy
+    from ground_station.support_mpc.cost_check import support_cost_numpy
     from ground_station.work_mpc import predict_work
 
     control, grid = world.scenario.control, world.map_grid()

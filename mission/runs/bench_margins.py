@@ -43,24 +43,24 @@ def bench_margins(cycles: int = 200) -> list[BenchResult]:
 
 def _posed(world, cycles: int) -> list:
     """Every support MPC problem posed in the first ``cycles`` of a detached Along AC run."""
-    from ground_station import support_planning
+    from ground_station.support_mpc import sharing
     from mission.link.plan_files import read_plan
     from mission.runs.detached import run_detached
 
     plan = read_plan(world.scenario)
     waypoints = {"work": plan.work, **{f"support-{n + 1}": s for n, s in enumerate(plan.supports)}}
     requests = []
-    recording = support_planning.LocalPlanner.plan_all
+    recording = sharing.LocalPlanner.plan_all
 
     def record(planner, batch):
         requests.extend(batch)
         return recording(planner, batch)
 
-    support_planning.LocalPlanner.plan_all = record
+    sharing.LocalPlanner.plan_all = record
     try:
         run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
     finally:
-        support_planning.LocalPlanner.plan_all = recording
+        sharing.LocalPlanner.plan_all = recording
     return requests
 
 
@@ -68,7 +68,7 @@ def _ratios(requests: list, paper, safe) -> tuple[float, float]:
     """(median, p95) of the solve time with the margins over without, on ``requests``."""
     import numpy as np
 
-    from ground_station.support_mpc import SupportMpc
+    from ground_station.support_mpc.mpc import SupportMpc
 
     sigma0, grid, camera = paper.sigma0_map().sigma_m, paper.map_grid(), paper.camera
     others = safe.scenario.task.supports

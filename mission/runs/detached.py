@@ -1,7 +1,7 @@
 """The control cycle against in-process vehicles: no sockets, no MAVLink.
 
 The vehicles here move exactly as :mod:`vehicle_sim` moves them (same kinematics, same sensor
-models), so the ground station's algorithms can be timed and studied without processes, as
+context), so the ground station's algorithms can be timed and studied without processes, as
 BlueSky's detached node runs a simulation without a network. Used by the benchmarks.
 """
 
@@ -13,7 +13,7 @@ import numpy as np
 
 from ground_station.cycle import CycleOutput, run_cycle
 from ground_station.localize import SupportReport
-from ground_station.models import build_models
+from ground_station.run_context import build_run_context
 from mission.world.model import World
 from vehicle_sim.kinematics import Kinematics
 
@@ -37,7 +37,7 @@ def run_detached(
     """Run up to ``max_cycles`` control cycles (or to completion)."""
     scenario = world.scenario
     control = scenario.control
-    models, state = build_models(world.known(), waypoints, adaptive, seed)
+    context, state = build_run_context(world.known(), waypoints, adaptive, seed)
     rng = np.random.default_rng([seed, 99])
     vehicles = {name: Kinematics.at(points[0]) for name, points in waypoints.items()}
     speed = {
@@ -48,13 +48,13 @@ def run_detached(
     for _ in range(max_cycles):
         work_truth = vehicles["work"].truth
         reports = []
-        for name in models.support_waypoints:
+        for name in context.support_waypoints:
             y = vehicles[name].truth
             fix = world.gnss.sample_fix(y, rng, world.zone_offset(y[None])[0])
             observation = world.camera.observe(y, work_truth, rng)
             position = fix.position_m if fix.has_fix else None
             reports.append(SupportReport(name, position, observation.relative_m))
-        output = run_cycle(state, reports, models)
+        output = run_cycle(state, reports, context)
         outputs.append(output)
         truth.append(work_truth.copy())
         if not output.fusion.blind:  # blind, the work UAV holds on its own dead reckoning

@@ -35,7 +35,7 @@ from mission.procs.stopping import stop_processes
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
 SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
-# what the ground station says of a first run's compilation (ground_station.nlp_cache's
+# what the ground station says of a first run's compilation (ground_station.support_mpc.nlp_cache's
 # COMPILING and COMPILED, written out here: importing it would import casadi)
 COMPILE_NEWS = ("compiling the support MPC", "compiled the support MPC")
 _COMPILED = re.compile(r"compiled the support MPC in ([\d.]+) s")

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from ground_station.margins import SLOTS, Margins
-from ground_station.models import build_models
 from ground_station.plan import plan, work_must_wait
-from ground_station.support_mpc import CONVERGED, SupportMpc
-from ground_station.support_nlp import SOFT
+from ground_station.run_context import build_run_context
+from ground_station.support_mpc.margins import SLOTS, Margins
+from ground_station.support_mpc.mpc import CONVERGED, SupportMpc
+from ground_station.support_mpc.nlp import SOFT
 from ground_station.work_mpc import predict_work
 from mission.config.scenario import load_scenario
 from mission.link.plan_files import read_plan
@@ -79,16 +79,16 @@ def test_the_work_uav_waits_rather_than_step_into_a_margin(along):
         "work": plan_.work,
         **{f"support-{n + 1}": s for n, s in enumerate(plan_.supports)},
     }
-    models, state = build_models(known, waypoints, True, 0)
+    context, state = build_run_context(known, waypoints, True, 0)
     state.xhat = plan_.work[0].copy()
     ahead = plan_.work[1] - plan_.work[0]
     ahead /= np.linalg.norm(ahead)
     state.yhat["support-1"] = state.xhat + 2.1 * ahead  # just outside 2 m; the next step is in
-    formation = plan(state, models, list(models.support_waypoints))
-    assert work_must_wait(state, state.xhat + 0.3 * ahead, models)
+    formation = plan(state, context, list(context.support_waypoints))
+    assert work_must_wait(state, state.xhat + 0.3 * ahead, context)
     np.testing.assert_array_equal(formation.work.command, state.xhat)
     state.yhat["support-1"] = state.xhat - 1.5 * ahead  # inside already, behind: stepping away
-    formation = plan(state, models, list(models.support_waypoints))
+    formation = plan(state, context, list(context.support_waypoints))
     assert np.linalg.norm(formation.work.command - state.xhat) > 0.1
 
 

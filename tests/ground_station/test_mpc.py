@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground_station.localizability import LocalizabilityMap, hermite_zero_slope
-from ground_station.nlp_cache import c_compiler
-from ground_station.support_mpc import CONVERGED, SupportMpc
+from ground_station.gnss_map import LocalizabilityMap, hermite_zero_slope
+from ground_station.support_mpc.mpc import CONVERGED, SupportMpc
+from ground_station.support_mpc.nlp_cache import c_compiler
 from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
 
@@ -107,7 +107,7 @@ def test_casadi_optimum_matches_scipy_on_the_numpy_cost(setting, offset):
     branch) or, with the terminal out of reach, beyond it (the far branch)."""
     from scipy.optimize import minimize
 
-    from ground_station.support_cost import support_cost_numpy
+    from ground_station.support_mpc.cost_check import support_cost_numpy
 
     world, plan, grid, mpc = setting
     control = world.scenario.control

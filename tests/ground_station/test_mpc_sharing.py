@@ -10,8 +10,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ground_station.support_mpc import CONVERGED, PlanRequest, SupportMpc, SupportPlan
-from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
+from ground_station.support_mpc.mpc import CONVERGED, PlanRequest, SupportMpc, SupportPlan
+from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
 from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
 
@@ -103,12 +103,12 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
     IPOPT's algorithm, and the interpreter evaluates the same functions."""
     from dataclasses import replace as replaced
 
-    from ground_station import support_nlp
+    from ground_station.support_mpc import nlp
 
     def no_compiling(*_):
         raise AssertionError("compiled=False compiles nothing")
 
-    monkeypatch.setattr(support_nlp, "compiled_nlps", no_compiling)
+    monkeypatch.setattr(nlp, "compiled_nlps", no_compiling)
     control = replaced(along_world.scenario.control, mpc_solver=solver)
     sigma0 = along_world.sigma0_map().sigma_m
     interpreted = SupportMpc(

@@ -8,15 +8,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ground_station.nlp_cache import c_compiler
-from ground_station.support_nlp import FATROP_OPTIONS
+from ground_station.support_mpc.nlp import FATROP_OPTIONS
+from ground_station.support_mpc.nlp_cache import c_compiler
 
 
 def _tiny_solver():
     """A two-variable NLP: min (x - p)^2 + (y - 2p)^2 with x + y >= 1, solved by IPOPT."""
     import casadi as ca
 
-    from ground_station.support_nlp import IPOPT_OPTIONS
+    from ground_station.support_mpc.nlp import IPOPT_OPTIONS
 
     x, p = ca.MX.sym("x", 2), ca.MX.sym("p")
     nlp = {"x": x, "p": p, "f": (x[0] - p) ** 2 + (x[1] - 2 * p) ** 2, "g": x[0] + x[1]}
@@ -25,7 +25,7 @@ def _tiny_solver():
 
 def _compiled_one(name, plugin, nlp, options, fallback_dir):
     """The library of one NLP, as ``compiled_nlps`` makes it."""
-    from ground_station import nlp_cache
+    from ground_station.support_mpc import nlp_cache
 
     build = nlp_cache.NlpBuild(name, plugin, nlp, options)
     return nlp_cache.compiled_nlps([build], fallback_dir)[0]
@@ -34,7 +34,7 @@ def _compiled_one(name, plugin, nlp, options, fallback_dir):
 def test_a_compilation_says_so_and_how_long_it_took_and_a_hit_says_nothing(
     tmp_path, monkeypatch, capsys
 ):
-    from ground_station import nlp_cache
+    from ground_station.support_mpc import nlp_cache
 
     if c_compiler() is None:
         return
@@ -55,7 +55,7 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
 
     import casadi as ca
 
-    from ground_station import nlp_cache
+    from ground_station.support_mpc import nlp_cache
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     scratch = tmp_path / "tmp"
@@ -117,7 +117,7 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
 
     import casadi as ca
 
-    from ground_station import nlp_cache
+    from ground_station.support_mpc import nlp_cache
 
     if c_compiler() is None:
         return

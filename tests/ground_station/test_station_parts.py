@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 from pymavlink import mavutil
 
-from ground_station.clock import await_step
 from ground_station.cycle import run_cycle
+from ground_station.links.clock import await_step
+from ground_station.links.outgoing import position_target, vision_position_estimate
 from ground_station.localize import reports_from_messages
-from ground_station.models import build_models
-from ground_station.outgoing import position_target, vision_position_estimate
+from ground_station.run_context import build_run_context
 from ground_station.station import GroundStation, StationConfig
 from mission.config.settings import Zone
 from mission.link.mavlink_udp import MavlinkCodec
@@ -47,7 +47,7 @@ def test_sim_state_is_logged_but_never_kept_or_used(along, along_world, tmp_path
     outputs = []
     for truth_shift in (0.0, 50.0):
         station = GroundStation(along_world.known(), _config(along, tmp_path / str(truth_shift)))
-        models, state = build_models(station.world, _waypoints(plan), True, 0)
+        context, state = build_run_context(station.world, _waypoints(plan), True, 0)
         station.clock.time_s = 0.5
         messages_rng = np.random.default_rng(11)
         for n in range(3):
@@ -65,7 +65,7 @@ def test_sim_state_is_logged_but_never_kept_or_used(along, along_world, tmp_path
         reports = reports_from_messages(station.links.support_samples(), frame)
         assert all(r.fix is not None and r.relative is not None for r in reports)
         assert all("SIM_STATE" not in v.latest for v in station.links.views.values())
-        output = run_cycle(state, reports, models)
+        output = run_cycle(state, reports, context)
         outputs.append((output.work_target, output.support_targets, state.xhat.copy()))
         station.close()
         log = mavutil.mavlink_connection(str(tmp_path / str(truth_shift) / "gcs.tlog"))
@@ -167,7 +167,7 @@ def _holds_a_zone(root: object) -> bool:
 
 
 def test_nothing_the_ground_station_builds_holds_a_zone(along, tmp_path):
-    """Built as its command line builds it, the ground station, its models and its state
+    """Built as its command line builds it, the ground station, its context and its state
     reach no zone, no zone list and no simulated World; a vehicle's world does (the search
     finds zones where they are)."""
     assert along.world.zones  # the scenario has one
@@ -176,9 +176,9 @@ def test_nothing_the_ground_station_builds_holds_a_zone(along, tmp_path):
     assert not hasattr(known, "zone_offset") and not hasattr(known, "zones")
     station = GroundStation(known, _config(along, tmp_path))
     try:
-        models, state = build_models(known, _waypoints(read_plan(along)), True, 0)
-        station.models = models
-        for built in (station, models, state):
+        context, state = build_run_context(known, _waypoints(read_plan(along)), True, 0)
+        station.context = context
+        for built in (station, context, state):
             assert not _holds_a_zone(built)
     finally:
         station.close()
@@ -189,7 +189,7 @@ def test_the_ground_station_refuses_a_world_with_zones(along, along_world, tmp_p
     with pytest.raises(TypeError, match="KnownWorld"):
         GroundStation(along_world, _config(along, tmp_path))
     with pytest.raises(TypeError, match="KnownWorld"):
-        build_models(along_world, _waypoints(read_plan(along)), True, 0)
+        build_run_context(along_world, _waypoints(read_plan(along)), True, 0)
 
 
 @pytest.mark.parametrize("escape_starts", [True, False])
@@ -200,12 +200,12 @@ def test_escape_starts_are_asked_for_where_g_has_risen_unless_switched_off(escap
 
     scenario = load_scenario("along", {"control.escape_starts": escape_starts})
     known = KnownWorld(scenario)
-    models, state = build_models(known, _waypoints(read_plan(scenario)), True, 0)
+    context, state = build_run_context(known, _waypoints(read_plan(scenario)), True, 0)
     horizon = scenario.control.horizon_steps
     work = WorkPrediction(np.repeat(state.xhat[None], horizon + 1, 0), np.zeros(horizon + 1, int))
-    assert not support_request(state, "support-1", work, models).escape  # G as predicted
-    models.g.values += 2.0  # GNSS worse everywhere than the prior map said
-    assert support_request(state, "support-1", work, models).escape is escape_starts
+    assert not support_request(state, "support-1", work, context).escape  # G as predicted
+    context.g.values += 2.0  # GNSS worse everywhere than the prior map said
+    assert support_request(state, "support-1", work, context).escape is escape_starts
 
 
 def test_a_vehicle_is_lost_after_simulated_seconds_and_never_a_wall_moment(along, tmp_path):

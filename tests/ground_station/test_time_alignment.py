@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from ground_station.align import align
-from ground_station.clock import StationClock
-from ground_station.clock_sync import ClockOffsets
-from ground_station.links import MAX_AGE_STEPS, VehicleLinks
+from ground_station.links.clock import StationClock
+from ground_station.links.clock_sync import ClockOffsets
+from ground_station.links.tlog import TlogWriter
+from ground_station.links.vehicle_links import MAX_AGE_STEPS, VehicleLinks
 from ground_station.localize import SupportReport
 from ground_station.state import StationState
-from ground_station.tlog import TlogWriter
 from mission.link.impairment import LinkSettings
 
 
@@ -101,7 +101,7 @@ def test_the_real_time_schedule_keeps_its_beat_and_skips_cycles_it_fell_behind()
     the next one is the latest due."""
     import time
 
-    from ground_station.clock import CYCLE_LAG_STEPS, PendingStep, await_step
+    from ground_station.links.clock import CYCLE_LAG_STEPS, PendingStep, await_step
 
     class Links:  # receives nothing for as long as the schedule asks, and notes how long
         def __init__(self) -> None:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ground_station.mission_client import MissionClient, MissionTransferError
+from ground_station.links.mission_client import MissionClient, MissionTransferError
 from mission.link.waypoints import (
     WaypointRow,
     format_waypoints,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ground_station import nlp_cache
+from ground_station.support_mpc import nlp_cache
 from mission.runs.orchestrator import COMPILE_NEWS, LogRelay
 
 

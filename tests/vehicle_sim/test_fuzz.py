@@ -8,7 +8,7 @@ import time
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.mission_client import MissionClient
+from ground_station.links.mission_client import MissionClient
 from mission.link.mission_items import MissionItem
 from tests.fuzzing import hostile_datagrams
 from tests.mav_client import MavClient

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.mission_client import MissionClient
+from ground_station.links.mission_client import MissionClient
 from mission.link.mission_items import MISSION, MissionItem
 from mission.link.waypoints import (
     WaypointRow,

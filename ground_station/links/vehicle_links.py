@@ -5,8 +5,8 @@ Messages are accepted only from the vehicles' own addresses. SIM_STATE (the simu
 goes to the tlog for analysis and is not kept: nothing here or above can read it.
 
 A measurement's time is its own stamp (``time_usec``), mapped onto the ground station's clock
-with the vehicle's clock offset (:mod:`~ground_station.clock_sync`); its age at a cycle is the
-cycle's time minus that. In lockstep only the step's own measurements are used: age zero.
+with the vehicle's clock offset (:mod:`~ground_station.links.clock_sync`); its age at a cycle is
+the cycle's time minus that. In lockstep only the step's own measurements are used: age zero.
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from ground_station.clock import StationClock
-from ground_station.clock_sync import ClockOffsets
-from ground_station.outgoing import (
+from ground_station.links.clock import StationClock
+from ground_station.links.clock_sync import ClockOffsets
+from ground_station.links.outgoing import (
     GCS_COMPONENT_ID,
     GCS_SYSTEM_ID,
     GUIDED_AND_ARMED,
@@ -28,7 +28,7 @@ from ground_station.outgoing import (
     statustext,
     timesync_request,
 )
-from ground_station.tlog import TlogWriter
+from ground_station.links.tlog import TlogWriter
 from mission.link.impairment import LinkSettings
 from mission.link.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.link.vehicle_identity import VehicleIdentity

@@ -1,6 +1,6 @@
 """The margins' half-spaces of every step as one casadi function, compiled like the NLPs.
 
-:class:`ground_station.margins.Margins` defines them; this computes the same values for
+:class:`ground_station.support_mpc.margins.Margins` defines them; this computes the same values for
 boxes and a fixed number of other UAVs, with the same IEEE operations in the same order
 (sums left to right, the slots chosen by a stable selection), so the same to the last bit
 but the sign of a zero. In Python they took about 80 us a solve, the largest share of what

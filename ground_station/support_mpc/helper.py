@@ -1,16 +1,16 @@
-"""``python -m ground_station.mpc_helper``: a process that solves support MPCs for the ground
-station, so two cores share a cycle's solves.
+"""``python -m ground_station.support_mpc.helper``: a process that solves support MPCs for the
+ground station, so two cores share a cycle's solves.
 
 It reads pickled frames on stdin and answers on stdout: first the scenario and the ground
 station's sigma_0 map (it builds its own world and solver, the same as the ground
 station's), then lists of
-:class:`~ground_station.support_mpc.PlanRequest`, each answered with the list of plans or an
+:class:`~ground_station.support_mpc.mpc.PlanRequest`, each answered with the list of plans or an
 error text. A frame is a 4-byte big-endian length and a pickle; both ends are this program.
 The helper ends at end of input, i.e. when the ground station closes the pipe or dies.
 
 A ground station with one thread forks its helper (:mod:`mission.procs.forked`), which then serves
 two pipes (:func:`serve_descriptors`) with the station's imports already made; otherwise it
-starts ``python -m ground_station.mpc_helper``, whose ``--for LABEL`` (the station's output
+starts ``python -m ground_station.support_mpc.helper``, whose ``--for LABEL`` (the station's output
 directory) only names it in ``ps``. Either way it calls itself ``gcs-mpc-helper``.
 """
 
@@ -48,7 +48,7 @@ def read_frame(stream: BinaryIO) -> Any:
 
 def serve(requests: BinaryIO, answers: BinaryIO) -> None:
     """Build the solver from the first frame, then answer request lists until end of input."""
-    from ground_station.support_mpc import SupportMpc
+    from ground_station.support_mpc.mpc import SupportMpc
     from mission.procs.cli_common import freeze_startup_heap
     from mission.world.model import KnownWorld
 

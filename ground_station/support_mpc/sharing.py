@@ -1,7 +1,7 @@
 """Who solves a cycle's support MPCs: this process alone, or this process and a helper.
 
 A run is a chain that keeps one core busy at a time, and the support MPCs are most of the
-ground station's cycle. With a helper process (:mod:`ground_station.mpc_helper`) the second
+ground station's cycle. With a helper process (:mod:`ground_station.support_mpc.helper`) the second
 core takes part of them: the solves expected to take longest (by each support's last solve
 time) are shared out longest first, each to whichever side has less to do, as in LPT
 scheduling. A solve is a pure function of its request, so the plans are the same bit for bit
@@ -19,8 +19,8 @@ from typing import BinaryIO
 
 import numpy as np
 
-from ground_station.mpc_helper import read_frame, write_frame
-from ground_station.support_mpc import PlanRequest, SupportMpc, SupportPlan
+from ground_station.support_mpc.helper import read_frame, write_frame
+from ground_station.support_mpc.mpc import PlanRequest, SupportMpc, SupportPlan
 from mission.config.settings import Scenario
 from mission.procs.cli_common import child_environment
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
@@ -125,7 +125,7 @@ class MpcHelper:
 
     def __init__(self, label: str = "", fork: bool = True) -> None:
         """Start the helper: forked from this process where that is safe and ``fork`` allows
-        it, else as ``python -m ground_station.mpc_helper --for LABEL`` (``label``, e.g. the
+        it, else as ``python -m ground_station.support_mpc.helper --for LABEL`` (``label``, e.g. the
         run's directory, tells ``ps`` whose helper it is). Its set-up follows with
         :meth:`set_up`."""
         self.process: subprocess.Popen | ForkedProcess
@@ -166,7 +166,7 @@ class MpcHelper:
 
 def _forked_helper() -> tuple[ForkedProcess, BinaryIO, BinaryIO]:
     """A helper forked from this process: (process, its requests' writer, answers' reader)."""
-    from ground_station.mpc_helper import serve_descriptors
+    from ground_station.support_mpc.helper import serve_descriptors
 
     requests_in, requests_out = os.pipe()
     answers_in, answers_out = os.pipe()
@@ -182,9 +182,14 @@ def _forked_helper() -> tuple[ForkedProcess, BinaryIO, BinaryIO]:
 
 
 def _executed_helper(label: str) -> tuple[subprocess.Popen, BinaryIO, BinaryIO]:
-    """``python -m ground_station.mpc_helper``: (process, its stdin, its stdout)."""
+    """``python -m ground_station.support_mpc.helper``: (process, its stdin, its stdout)."""
     process = subprocess.Popen(
-        [sys.executable, "-m", "ground_station.mpc_helper", *(["--for", label] if label else [])],
+        [
+            sys.executable,
+            "-m",
+            "ground_station.support_mpc.helper",
+            *(["--for", label] if label else []),
+        ],
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         env=child_environment(),

@@ -10,20 +10,20 @@ Decision variables: the U predicted positions V'_n. Cost, exactly the paper's fo
 
 With margins (``control.min_separation_m`` or ``control.clearance_m`` above zero), each step
 u must also lie in ``slots`` half-spaces n.v_u >= b (the other UAVs' and the structure's,
-linearised at the guess: :mod:`ground_station.margins`), in two forms: *hard*, as
+linearised at the guess: :mod:`ground_station.support_mpc.margins`), in two forms: *hard*, as
 constraints, and *soft*, as an exact L1 penalty (one slack s_u >= 0 per step relaxes every
 half-space of that step, at MARGIN_WEIGHT per metre in the cost). The soft problem is always
 feasible, and where the margins can be kept its slacks are zero (the weight exceeds any
 multiplier the other terms can produce): it has the hard problem's minimum there. The hard
 one is cheaper to solve (15 variables and no slack rows, against 20 and 5 more: fewer and
 cheaper iterations), so it is solved first and the soft one only where it fails (see
-:mod:`ground_station.support_mpc`).
+:mod:`ground_station.support_mpc.mpc`).
 
 Each step is also bounded hard by d_max (the vehicle cannot fly faster), where xi is exactly
 w_interval d^2; the terminal link keeps the jump at d_max, which the solver sees as two smooth
 NLPs, *near* (|w - v_U| <= d_max, weight w_interval) and *far* (weight w_penalty): see
-:mod:`ground_station.support_mpc`. G_s enters as the explicit eight-corner sum of
-:func:`~ground_station.localizability.casadi_hermite` over a window of voxels around yhat_n,
+:mod:`ground_station.support_mpc.mpc`. G_s enters as the explicit eight-corner sum of
+:func:`~ground_station.gnss_map.casadi_hermite` over a window of voxels around yhat_n,
 so the solver gets exact second derivatives.
 """
 
@@ -36,9 +36,9 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ground_station.casadi_buffer import BufferedFunction
-from ground_station.localizability import inlined_hermite
-from ground_station.nlp_cache import NlpBuild, compiled_nlps
+from ground_station.gnss_map import inlined_hermite
+from ground_station.support_mpc.casadi_buffer import BufferedFunction
+from ground_station.support_mpc.nlp_cache import NlpBuild, compiled_nlps
 from mission.config.settings import ControlSettings
 from mission.world.grid import VoxelGrid
 
@@ -80,7 +80,7 @@ class NlpSymbols:
     targets: ca.MX  # (3, U) w_{n,k_u}
     terminal: ca.MX  # w_{n,k_{U+1}}
     work: ca.MX  # (3, U) the work UAV's predicted path
-    anchors: ca.MX  # (3, U) where a blocked step is pulled (see ground_station.los_anchors)
+    anchors: ca.MX  # (3, U) where a blocked step is pulled (see support_mpc.los_anchors)
     blocked: ca.MX  # (U,) 1 where the step is not observable
     values: ca.MX  # G over the window
     prior: ca.MX  # sigma_0 over the window (empty without the shadow constraint)

@@ -1,4 +1,4 @@
-"""MPC of each support UAV (paper 4.2.2): its NLP (:mod:`ground_station.support_nlp`) solved
+"""MPC of each support UAV (paper 4.2.2): its NLP (:mod:`ground_station.support_mpc.nlp`) solved
 with casadi + fatrop (or IPOPT), built once per run, for any support with its own parameters.
 
 Observability (range and line of sight between V^(w)_u and v_u) is not differentiable: it is
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.los_anchors import LosAnchors
-from ground_station.margins import Margins
-from ground_station.support_nlp import MARGIN_WEIGHT, SOFT, build_support_nlp
+from ground_station.support_mpc.los_anchors import LosAnchors
+from ground_station.support_mpc.margins import Margins
+from ground_station.support_mpc.nlp import MARGIN_WEIGHT, SOFT, build_support_nlp
 from mission.config.resources import mpc_window_shape
 from mission.config.settings import ControlSettings
 from mission.world.camera import CameraModel
@@ -333,7 +333,8 @@ class SupportMpc:
     def anchors(
         self, guess: np.ndarray, work: np.ndarray, targets: np.ndarray, blocked: np.ndarray
     ) -> np.ndarray:
-        """Where the LOS penalty pulls each blocked step (:mod:`ground_station.los_anchors`)."""
+        """Where the LOS penalty pulls each blocked step
+        (:mod:`ground_station.support_mpc.los_anchors`)."""
         return self._anchors(guess, work, targets, blocked)
 
     def _escape_guesses(self, yhat: np.ndarray, fixed: np.ndarray, flags: np.ndarray):

@@ -22,9 +22,9 @@ import math
 
 import numpy as np
 
-from ground_station.casadi_buffer import BufferedFunction
-from ground_station.margin_spaces import SpaceRules, half_spaces_function
-from ground_station.nlp_cache import compiled_function
+from ground_station.support_mpc.casadi_buffer import BufferedFunction
+from ground_station.support_mpc.margin_spaces import SpaceRules, half_spaces_function
+from ground_station.support_mpc.nlp_cache import compiled_function
 from mission.config.settings import ControlSettings
 from mission.world.proximity import StructureProximity
 from mission.world.structure import Structure
@@ -61,9 +61,9 @@ class Margins:
         self._function = self._compiled(compiled)
 
     def _compiled(self, compiled: bool) -> BufferedFunction | None:
-        """The half-spaces as a casadi function (:mod:`ground_station.margin_spaces`), compiled
-        where a C compiler is there and ``compiled`` asks for it; None where it does not apply
-        (no margins, or a mesh file among the pieces)."""
+        """The half-spaces as a casadi function (:mod:`ground_station.support_mpc.margin_spaces`),
+        compiled where a C compiler is there and ``compiled`` asks for it; None where it does
+        not apply (no margins, or a mesh file among the pieces)."""
         if self.slots == 0 or (self.clearance > 0 and self.proximity.has_file_mesh):
             return None
         rules = SpaceRules(

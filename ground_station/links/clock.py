@@ -22,7 +22,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from ground_station.outgoing import clock_tick
+from ground_station.links.outgoing import clock_tick
 from mission.config.settings import RunSettings
 from mission.procs.wall_grid import next_grid_instant
 
@@ -48,7 +48,8 @@ class LockstepTiming:
 
 
 class SteppingVehicle(Protocol):
-    """What the lockstep needs to know of a vehicle (:class:`ground_station.links.VehicleView`)."""
+    """What the lockstep needs to know of a vehicle
+    (:class:`ground_station.links.vehicle_links.VehicleView`)."""
 
     step_ms: int
     lost: bool
@@ -56,7 +57,8 @@ class SteppingVehicle(Protocol):
 
 
 class SteppingLinks(Protocol):
-    """The links as the lockstep uses them (:class:`ground_station.links.VehicleLinks`)."""
+    """The links as the lockstep uses them
+    (:class:`ground_station.links.vehicle_links.VehicleLinks`)."""
 
     views: Mapping[str, SteppingVehicle]
     stats: dict[str, int]

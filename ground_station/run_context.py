@@ -6,16 +6,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.localizability import LocalizabilityMap
+from ground_station.gnss_map import LocalizabilityMap
 from ground_station.state import StationState
-from ground_station.support_mpc import SupportMpc
-from ground_station.support_planning import HelperPlanner, LocalPlanner, MpcHelper
+from ground_station.support_mpc.mpc import SupportMpc
+from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
 from mission.config.settings import Scenario
 from mission.world.model import KnownWorld, World
 
 
 @dataclass
-class Models:
+class RunContext:
     """The scenario and the known world, the planned waypoints, the map G, the support MPC,
     the fusion's random generator and who solves the support MPCs."""
 
@@ -29,14 +29,14 @@ class Models:
     planner: LocalPlanner  # solves the support MPCs: here, or shared with a helper process
 
 
-def build_models(
+def build_run_context(
     world: KnownWorld,
     waypoints: dict[str, np.ndarray],
     adaptive: bool,
     seed: int,
     helper: MpcHelper | None = None,
     sigma0: np.ndarray | None = None,
-) -> tuple[Models, StationState]:
+) -> tuple[RunContext, StationState]:
     """Everything the control cycle needs, and the state at the start (vehicles at w_1); the
     support MPCs are shared with ``helper`` if one is given. ``sigma0`` is the world's sigma_0
     map if already computed."""
@@ -51,7 +51,7 @@ def build_models(
     planner = (
         LocalPlanner(mpc, observable) if helper is None else HelperPlanner(mpc, observable, helper)
     )
-    models = Models(
+    context = RunContext(
         scn,
         world,
         waypoints["work"],
@@ -66,7 +66,7 @@ def build_models(
         yhat={n: w[0].copy() for n, w in supports.items()},
         k=min(1, len(waypoints["work"]) - 1),
     )
-    return models, state
+    return context, state
 
 
 def require_known_world(world: KnownWorld) -> KnownWorld:
