@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mission.subcommands import run_line
+from mission.commands.run import run_line
 
 SUMMARY = {
     "completed": True,
@@ -48,7 +48,7 @@ def test_a_stopped_run_says_why_and_every_run_says_how_close_it_came():
 def test_real_time_at_1x_says_so_and_a_chosen_speed_up_does_not(capsys):
     from argparse import Namespace
 
-    from mission.subcommands import realtime_speedup
+    from mission.commands.common import realtime_speedup
 
     assert realtime_speedup(Namespace(realtime=True, speedup=None)) == 1.0
     assert "real time at 1x" in capsys.readouterr().err
@@ -59,8 +59,8 @@ def test_real_time_at_1x_says_so_and_a_chosen_speed_up_does_not(capsys):
 def test_the_bench_names_each_group_as_it_goes(monkeypatch):
     import io
 
-    from mission.runs import bench
-    from mission.runs.bench_result import BenchResult
+    from mission.bench import suite as bench
+    from mission.bench.result import BenchResult
 
     row = BenchResult("made_up", 1.0, "x", "reference", None)
     monkeypatch.setattr(bench, "BENCHMARKS", {"quick": lambda: [row], "other": lambda: []})

@@ -1,1 +1,1 @@
-"""Whole runs: orchestrator, batches, benchmarks, detached run. Imports: all but mission.cli."""
+"""The orchestrator of `mission run`. Imports: all but mission.commands, mission.bench."""

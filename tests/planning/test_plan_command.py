@@ -9,9 +9,9 @@ import pytest
 
 import mission
 from mission.cli import entry_point
+from mission.commands.plan import plan_directory
 from mission.config.errors import InputError
 from mission.config.scenario import load_scenario
-from mission.subcommands import plan_directory
 
 PACKAGE = Path(mission.__file__).resolve().parent
 SHIPPED = PACKAGE / "scenarios" / "plans" / "bridge"

@@ -42,7 +42,8 @@ def test_a_bad_save_path_is_refused_before_anything_is_written(short_run, tmp_pa
 
 def test_a_run_without_view_does_not_import_rerun():
     code = (
-        "import sys; from mission import cli, subcommands; from mission.runs import orchestrator;"
+        "import sys; from mission import cli; from mission.commands import run;"
+        "from mission.runs import orchestrator;"
         "from mission.viewer import live, replay, feed;"
         "print('rerun' in sys.modules)"
     )

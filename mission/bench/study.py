@@ -9,7 +9,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from mission.runs.bench_result import BenchResult
+from mission.bench.result import BenchResult
 
 BENCH_STUDY = "name: bench\nscenarios: [along]\nmethods: [ac, nac]\nseeds: 10\n"
 JOBS = 2

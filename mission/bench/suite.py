@@ -16,15 +16,15 @@ from typing import Any, TextIO
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.bench.margins import bench_margins
+from mission.bench.result import BenchResult
+from mission.bench.study import bench_studies
+from mission.bench.view import bench_view
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.procs.cli_common import child_environment
 from mission.procs.commands import mission_run_argv
 from mission.procs.machine_speed import python_loop_s
 from mission.procs.stopping import stop_processes
-from mission.runs.bench_margins import bench_margins
-from mission.runs.bench_result import BenchResult
-from mission.runs.bench_study import bench_studies
-from mission.runs.bench_view import bench_view
 
 
 def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
@@ -153,8 +153,8 @@ def bench_ground_station(
     ``repeats`` runs; scipy vs casadi."""
     import numpy as np
 
+    from mission.bench.detached import run_detached
     from mission.link.plan_files import read_plan
-    from mission.runs.detached import run_detached
     from mission.world.model import World
 
     world = World.load("along")

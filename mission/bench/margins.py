@@ -11,7 +11,7 @@ from __future__ import annotations
 import statistics
 import time
 
-from mission.runs.bench_result import BenchResult
+from mission.bench.result import BenchResult
 
 TARGET = 1.25  # the margins may cost at most a quarter more, median and p95
 PAPER_FORM = {"control.min_separation_m": 0, "control.clearance_m": 0}
@@ -44,8 +44,8 @@ def bench_margins(cycles: int = 200) -> list[BenchResult]:
 def _posed(world, cycles: int) -> list:
     """Every support MPC problem posed in the first ``cycles`` of a detached Along AC run."""
     from ground_station.support_mpc import sharing
+    from mission.bench.detached import run_detached
     from mission.link.plan_files import read_plan
-    from mission.runs.detached import run_detached
 
     plan = read_plan(world.scenario)
     waypoints = {"work": plan.work, **{f"support-{n + 1}": s for n, s in enumerate(plan.supports)}}

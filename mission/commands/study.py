@@ -1,4 +1,5 @@
-"""What ``mission study`` and ``mission batch`` (a study of one point, with Table 3) do."""
+"""``mission study``: a study file run on an engine (local or Ray), resumable; and the checks
+every study gets before it starts."""
 
 from __future__ import annotations
 
@@ -6,12 +7,55 @@ import argparse
 import os
 from pathlib import Path
 
+from mission.commands.common import preflight
 from mission.config.errors import InputError
 from mission.procs.interrupts import StopRequest
 from mission.procs.outputs import check_output_dir
-from mission.subcommands import preflight, realtime_speedup
 
 MAX_JOBS = 256
+
+
+def add_parser(commands) -> None:
+    """``mission study``'s arguments."""
+    parser = commands.add_parser(
+        "study",
+        help="run a study file (a sweep of scenarios x points x methods x seeds); "
+        "write results.csv and report.md",
+    )
+    parser.add_argument("file", type=Path, metavar="FILE.yaml", help="the study file")
+    parser.add_argument(
+        "--engine",
+        choices=["local", "ray"],
+        default="local",
+        help="local: child processes of this one; ray: Ray tasks (pip install -e '.[ray]')",
+    )
+    parser.add_argument(
+        "--address",
+        metavar="ADDR",
+        help="--engine ray: the cluster to join (default: RAY_ADDRESS, else a Ray started here)",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=int,
+        help="runs at once (default: local, this machine's cores; ray, as the cluster allows)",
+    )
+    parser.add_argument(
+        "--out", type=Path, metavar="DIR", help="where it goes (default results/NAME; resumable)"
+    )
+    parser.add_argument(
+        "--runs",
+        type=Path,
+        metavar="DIR",
+        help="the runs' folders (default DIR/runs); studies that share one make a run they "
+        "have in common once",
+    )
+    parser.add_argument(
+        "--keep",
+        choices=["all", "logs", "summary"],
+        default="all",
+        help="of each run's folder: all; logs (all but G's snapshots); summary (and scenario)",
+    )
+    parser.set_defaults(handler=study)
 
 
 def study(args: argparse.Namespace) -> int:
@@ -20,38 +64,10 @@ def study(args: argparse.Namespace) -> int:
 
     spec = load_study(args.file)
     out = args.out or Path("results") / spec.name
-    return _run(spec, out, args)
+    return run_study_command(spec, out, args)
 
 
-def batch(args: argparse.Namespace) -> int:
-    """``mission batch``: Table 3's study of the given scenarios, methods and seeds."""
-    from mission.studies.spec import METHODS, Point, StudySpec, scenario_reference
-
-    if not 1 <= args.trials <= 1000:
-        raise InputError("command line", "--trials", f"must be in [1, 1000], got {args.trials}")
-    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-    if not methods or any(m not in METHODS for m in methods):
-        raise InputError("command line", "--methods", f"expected ac and/or nac: {args.methods!r}")
-    scenarios = [scenario_reference(Path.cwd(), s, "SCENARIO") for s in args.scenarios]
-    spec = StudySpec(
-        name="batch",
-        description="The paper's Table 3: AC and NAC over paired seeds.",
-        source=Path("command line"),
-        scenarios=tuple(scenarios),
-        methods=tuple(dict.fromkeys(methods)),
-        seeds=tuple(range(args.trials)),
-        points=(Point(()),),
-        tables=("table3",),
-        speedup=realtime_speedup(args),
-    )
-    args.engine, args.address, args.keep, args.runs = "local", None, "all", None
-    status = _run(spec, args.out, args)
-    if (args.out / "table.md").is_file():
-        print((args.out / "table.md").read_text(), end="")
-    return status
-
-
-def _run(spec, out: Path, args: argparse.Namespace) -> int:
+def run_study_command(spec, out: Path, args: argparse.Namespace) -> int:
     """Check everything, then run the study on the chosen engine (which keys every run
     before it starts any)."""
     from mission.studies.study import run_study
@@ -88,6 +104,8 @@ def _run(spec, out: Path, args: argparse.Namespace) -> int:
 
 
 STUDY_FILES = ("results.csv", "report.md", "table.md", "table.csv", "boxplots.png")
+
+
 STUDY_FOLDERS = ("figures", "runs")
 
 

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from mission.runs import bench
+from mission.bench import suite as bench
 
 
 @dataclass
@@ -27,7 +27,7 @@ def _run(solves: list[float], cycles: list[float]) -> SimpleNamespace:
 
 
 def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
-    import mission.runs.detached
+    import mission.bench.detached
 
     repeats = iter(
         [  # solves (ms) and cycle times (ms) of three repeats of the same run
@@ -37,7 +37,7 @@ def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
         ]
     )
     monkeypatch.setattr(
-        mission.runs.detached, "run_detached", lambda *args, **kwargs: next(repeats)
+        mission.bench.detached, "run_detached", lambda *args, **kwargs: next(repeats)
     )
     monkeypatch.setattr(bench, "_scipy_over_casadi", lambda *args: 12.0)
     monkeypatch.setattr(bench, "_interpreted_over_compiled", lambda *args: 4.5)
@@ -99,7 +99,7 @@ def test_every_invocation_starts_with_the_machines_speed_without_a_verdict(monke
 
 
 def test_the_study_bench_reports_runs_per_hour_and_the_ray_to_local_ratio(monkeypatch):
-    from mission.runs import bench_study
+    from mission.bench import study as bench_study
 
     walls = iter([72.0, 75.6])  # local, then Ray
     monkeypatch.setattr(bench_study, "_wall", lambda spec, out, engine: next(walls))
@@ -110,7 +110,7 @@ def test_the_study_bench_reports_runs_per_hour_and_the_ray_to_local_ratio(monkey
 
 
 def test_the_margins_rows_hold_the_run_with_margins_to_the_target(monkeypatch):
-    from mission.runs import bench_margins
+    from mission.bench import margins as bench_margins
 
     posed = {}
     monkeypatch.setattr(

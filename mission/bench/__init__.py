@@ -1,0 +1,1 @@
+"""The benchmarks (`mission bench`), the detached run. Imports: all but mission.commands."""

@@ -1,0 +1,31 @@
+"""``mission bench``: the benchmarks, with their targets."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+
+def add_parser(commands) -> None:
+    """``mission bench``'s arguments."""
+    parser = commands.add_parser("bench", help="run the benchmarks and print their medians")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument(
+        "--only",
+        action="append",
+        choices=["world", "vehicle", "gcs", "margins", "run", "study", "view"],
+        help="run only this group (repeatable)",
+    )
+    parser.set_defaults(handler=bench)
+
+
+def bench(args: argparse.Namespace) -> int:
+    """``mission bench``."""
+    from mission.bench.suite import format_table, run_benchmarks
+
+    results = run_benchmarks(args.only)
+    if args.json:
+        print(json.dumps({r.name: r.value for r in results}))
+    else:
+        print(format_table(results))
+    return 0

@@ -1,0 +1,173 @@
+"""``mission run``: a mission flown, its vehicle processes and ground station started and
+stopped together."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from mission.commands.common import (
+    add_realtime_arguments,
+    add_scenario_argument,
+    preflight,
+    realtime_speedup,
+)
+from mission.config.errors import InputError
+from mission.link.impairment import add_link_arguments, link_settings
+from mission.procs.cli_common import check_seed
+from mission.procs.outputs import check_output_dir
+
+
+def add_parser(commands) -> None:
+    """``mission run``'s arguments."""
+    parser = commands.add_parser("run", help="run a mission: vehicle processes + ground station")
+    add_scenario_argument(parser)
+    parser.add_argument(
+        "--method",
+        choices=["ac", "nac"],
+        default="ac",
+        help="ac: adaptive control (G learned); nac: the baseline without the update",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="seed of every random draw of the run")
+    parser.add_argument(
+        "--out", type=Path, metavar="DIR", help="default logs/<scenario>-<method>-<seed>-<time>/"
+    )
+    add_realtime_arguments(parser, "the run")
+    parser.add_argument(
+        "--signing-key", type=Path, metavar="FILE", help="sign every link (32-byte secret)"
+    )
+    parser.add_argument(
+        "--observer",
+        metavar="HOST:PORT",
+        help="every vehicle also streams here (QGroundControl, MAVProxy); use with --realtime",
+    )
+    add_link_arguments(parser)
+    parser.add_argument(
+        "--mpc-helper",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="the ground station shares the support MPCs with a helper process "
+        "(default: with two or more cores; same results either way)",
+    )
+    parser.add_argument(
+        "--process-start",
+        choices=["fork", "exec"],
+        default="fork",
+        help="fork: the ground station and the vehicles are forked from this process, the "
+        "vehicles after one import of their code (exec where forking is unsafe); exec: each is "
+        "started as python -m ground_station / vehicle_sim (slower; ps shows its command "
+        "line). Same results either way",
+    )
+    parser.add_argument(
+        "--view",
+        nargs="?",
+        const="auto",
+        choices=["auto", "web", "native"],
+        help="stream the run to a Rerun viewer (auto: native with a display, else web)",
+    )
+    parser.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """``mission run``."""
+    import time
+
+    from mission.config.scenario import load_scenario
+    from mission.runs.orchestrator import RunFailed, RunOptions, run_mission
+
+    if args.exit_with_parent:
+        from mission.procs.cli_common import die_with_parent
+
+        die_with_parent()
+    check_seed(args.seed)
+    speedup = realtime_speedup(args)
+    scenario = load_scenario(args.scenario)
+    preflight(scenario)
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
+    check_output_dir(out, "--out")
+    if args.signing_key is not None:
+        from mission.link.signing import read_signing_key
+
+        read_signing_key(args.signing_key)  # a bad key fails here, before anything starts
+    if args.observer is not None:
+        from mission.link.mavlink_udp import parse_address
+
+        try:
+            parse_address(args.observer, "--observer")
+        except ValueError as error:
+            raise InputError("command line", "--observer", str(error)) from None
+    link = link_settings(args)
+    options = RunOptions(
+        args.scenario,
+        args.method,
+        args.seed,
+        out,
+        speedup,
+        args.signing_key.resolve() if args.signing_key else None,
+        args.observer,
+        link,
+        args.mpc_helper,
+        args.process_start,
+    )
+    print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
+    live = None
+    try:
+        live = _live_view(args.view, out, scenario) if args.view else None
+        summary = run_mission(options, scenario, live)
+        print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
+        if live is not None and live.viewer is not None:
+            from mission.viewer.replay import wait_for_viewer
+
+            wait_for_viewer(live.viewer)
+    except RunFailed as error:
+        print(f"run failed: {error}; logs kept in {out}", file=sys.stderr)
+        return 1
+    finally:
+        if live is not None:
+            live.close()
+    return 0
+
+
+def _live_view(choice: str, out: Path, scenario):
+    """The live view of ``mission run --view``: its viewer started (and its URL said)."""
+    from mission.runs.orchestrator import RunFailed
+    from mission.viewer.live import LiveView
+    from mission.viewer.process import ViewerFailed, start_viewer
+    from mission.viewer.replay import viewer_kind
+
+    kind = "native" if choice == "native" else viewer_kind(choice == "web")
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        viewer = start_viewer(kind, out / "viewer.log")
+    except ViewerFailed as error:
+        raise RunFailed(f"the viewer: {error}") from None
+    print(f"streaming to the viewer at {viewer.web_url or 'its native window'}", flush=True)
+    return LiveView(out, scenario, viewer)
+
+
+def run_line(summary: dict, timeout_s: float) -> str:
+    """A finished run in one line of text."""
+    if summary["completed"]:
+        done = f"completed at {summary['completion_time_s']:.1f} s"
+    elif summary.get("stopped"):
+        done = f"STOPPED: {summary['stopped']}"
+    else:
+        done = f"NOT completed within {timeout_s:g} s"
+    safety = summary.get("safety") or {}
+    approaches = list((safety.get("closest_approach_m") or {}).values())
+    clearances = list((safety.get("least_clearance_m") or {}).values())
+    closest = f"; closest approach {min(approaches):.2f} m" if approaches else ""
+    clear = f", least clearance {min(clearances):.2f} m" if clearances else ""
+    per_support = ", ".join(f"{name} {n}" for name, n in summary["multipath_steps"].items())
+    mean = summary["work_error_m"]["mean"]
+    error = "no estimate" if mean is None else f"mean {mean:.4f} m"
+    factor = summary["realtime_factor"]
+    speed = "" if factor is None else f", {factor:.0f}x real time"
+    return (
+        f"{done}; {summary['control_cycles']} cycles; steps in multipath "
+        f"{summary['multipath_steps_total']} ({per_support}); work UAV error {error}; "
+        f"wall {summary['wall_time_s']:.1f} s{speed}{closest}{clear}"
+    )
