@@ -29,6 +29,7 @@ from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
 from mission.procs.atomic import write_text_atomically
 from mission.procs.cli_common import child_environment
+from mission.procs.file_tail import FileTail
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
 from mission.procs.stopping import stop_processes
@@ -312,22 +313,14 @@ class LogRelay:
     def __init__(self, log: Path, prefixes: tuple[str, ...]) -> None:
         self.log = log
         self.pending = list(prefixes)
-        self._offset = 0
+        self._file = FileTail(log)
 
     def poll(self) -> None:
         """Show what has come since the last poll."""
         if not self.pending:
             return
-        try:
-            with self.log.open("rb") as handle:
-                handle.seek(self._offset)
-                data = handle.read()
-        except OSError:
-            return
-        end = data.rfind(b"\n") + 1  # whole lines only
-        self._offset += end
-        for line in data[:end].decode("utf-8", "replace").splitlines():
-            text = line.split(": ", 1)[-1]
+        for line in self._file.new_lines():
+            text = line.decode("utf-8", "replace").split(": ", 1)[-1]
             for prefix in list(self.pending):
                 if text.startswith(prefix):
                     print(text, file=sys.stderr, flush=True)

@@ -19,6 +19,7 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.analysis.metrics import scan_records
+from mission.procs.file_tail import FileTail
 
 VIEWED_IDS = frozenset(
     {
@@ -39,21 +40,16 @@ class TlogTail:
 
     def __init__(self, path: Path) -> None:
         self.path = path
-        self._offset = 0
+        self._file = FileTail(path)
         self._parser = mavlink2.MAVLink(None)
         self._station_tick_seen = False
 
     def read(self) -> list[Any]:
         """The new messages, each with its ``_timestamp`` (seconds of the tlog's clock)."""
-        try:
-            with self.path.open("rb") as handle:
-                handle.seek(self._offset)
-                data = handle.read()
-        except OSError:
-            return []
+        data = self._file.new_bytes()
         records, end, clean = scan_records(data, VIEWED_IDS)
         # past a damaged record nothing can be framed again: stop there for good
-        self._offset += end if clean else len(data)
+        self._file.advance(end if clean else len(data))
         messages = []
         for usec, packet in records:
             station = packet[5] == STATION_SYSTEM_ID  # its own: only its first clock tick
@@ -75,19 +71,11 @@ class RecordsTail:
 
     def __init__(self, path: Path) -> None:
         self.path = path
-        self._offset = 0
+        self._file = FileTail(path)
 
     def read(self) -> list[dict[str, Any]]:
-        try:
-            with self.path.open("rb") as handle:
-                handle.seek(self._offset)
-                data = handle.read()
-        except OSError:
-            return []
-        end = data.rfind(b"\n") + 1
-        self._offset += end
         records = []
-        for line in data[:end].splitlines():
+        for line in self._file.new_lines():
             try:
                 record = json.loads(line)
             except ValueError:
