@@ -31,6 +31,43 @@ OTHER_COMMANDS = {
 }
 
 
+INT32_MAX = 2**31 - 1
+# the fields every form of an item carries alike (x and y differ: see position_scale), in
+# MISSION_ITEM(_INT)'s order, with the type each holds
+COMMON_FIELDS = (
+    ("seq", int),
+    ("frame", int),
+    ("command", int),
+    ("current", int),
+    ("autocontinue", int),
+    ("param1", float),
+    ("param2", float),
+    ("param3", float),
+    ("param4", float),
+    ("z", float),
+)
+FLOAT32_FIELDS = ("param1", "param2", "param3", "param4", "z")  # float on the wire
+
+
+def position_scale(frame: int) -> float:
+    """What MISSION_ITEM_INT's x and y hold in ``frame``: 1e-7 degrees in a global frame,
+    the float form's value as it is in any other (a command's params 5 and 6). The one rule
+    for the float MISSION_ITEM and for waypoint files alike."""
+    return 1e7 if frame in GLOBAL_FRAMES else 1.0
+
+
+def to_int_field(value: float, frame: int) -> int:
+    """x or y as MISSION_ITEM_INT holds it; a value it cannot hold becomes INT32_MAX (which
+    validation rejects)."""
+    scaled = value * position_scale(frame) if math.isfinite(value) else math.inf
+    return round(scaled) if abs(scaled) < INT32_MAX else INT32_MAX
+
+
+def from_int_field(value: int, frame: int) -> float:
+    """x or y as the float forms (MISSION_ITEM, a waypoint file) hold it."""
+    return value / position_scale(frame)
+
+
 @dataclass(frozen=True)
 class MissionItem:
     """One stored item, exactly as MISSION_ITEM_INT carries it (x, y in 1e-7 degrees)."""
@@ -50,71 +87,27 @@ class MissionItem:
 
     @classmethod
     def from_message(cls, msg: Any) -> MissionItem:
-        """From MISSION_ITEM_INT, or from the float MISSION_ITEM (degrees scaled by 1e7)."""
+        """From MISSION_ITEM_INT, or from the float MISSION_ITEM (see :func:`position_scale`)."""
+        common = {name: kind(getattr(msg, name)) for name, kind in COMMON_FIELDS}
         if msg.get_type() == "MISSION_ITEM_INT":
-            x, y = int(msg.x), int(msg.y)
-        else:
-            x, y = _degrees_to_e7(msg.x), _degrees_to_e7(msg.y)
-        return cls(
-            int(msg.seq),
-            int(msg.frame),
-            int(msg.command),
-            int(msg.current),
-            int(msg.autocontinue),
-            float(msg.param1),
-            float(msg.param2),
-            float(msg.param3),
-            float(msg.param4),
-            x,
-            y,
-            float(msg.z),
-        )
+            return cls(**common, x=int(msg.x), y=int(msg.y))
+        frame = common["frame"]
+        return cls(**common, x=to_int_field(msg.x, frame), y=to_int_field(msg.y, frame))
 
     def to_int_message(self, target: tuple[int, int]) -> Any:
         """As MISSION_ITEM_INT addressed to ``target`` (system, component)."""
-        return mavlink2.MAVLink_mission_item_int_message(
-            target[0],
-            target[1],
-            self.seq,
-            self.frame,
-            self.command,
-            self.current,
-            self.autocontinue,
-            self.param1,
-            self.param2,
-            self.param3,
-            self.param4,
-            self.x,
-            self.y,
-            self.z,
-            MISSION,
-        )
+        fields = self._message_fields(self.x, self.y)
+        return mavlink2.MAVLink_mission_item_int_message(*target, *fields, MISSION)
 
     def to_float_message(self, target: tuple[int, int]) -> Any:
         """As the legacy float MISSION_ITEM."""
-        return mavlink2.MAVLink_mission_item_message(
-            target[0],
-            target[1],
-            self.seq,
-            self.frame,
-            self.command,
-            self.current,
-            self.autocontinue,
-            self.param1,
-            self.param2,
-            self.param3,
-            self.param4,
-            self.x / 1e7,
-            self.y / 1e7,
-            self.z,
-            MISSION,
-        )
+        x, y = from_int_field(self.x, self.frame), from_int_field(self.y, self.frame)
+        return mavlink2.MAVLink_mission_item_message(*target, *self._message_fields(x, y), MISSION)
 
-
-def _degrees_to_e7(value: float) -> int:
-    if not math.isfinite(value) or abs(value) > 1000:
-        return 2**31 - 1  # out of range: validation rejects it
-    return round(value * 1e7)
+    def _message_fields(self, x: float, y: float) -> tuple:
+        """The fields of MISSION_ITEM(_INT) after the target, before the mission type."""
+        common = [getattr(self, name) for name, _ in COMMON_FIELDS]
+        return (*common[:-1], x, y, common[-1])  # z after x and y
 
 
 def check_item(item: MissionItem) -> int:

@@ -14,7 +14,15 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.config.errors import InputError, read_text_file
-from mission.link.mission_items import GLOBAL_FRAMES, MissionItem, float32_decimal
+from mission.link.mission_items import (
+    COMMON_FIELDS,
+    FLOAT32_FIELDS,
+    GLOBAL_FRAMES,
+    MissionItem,
+    float32_decimal,
+    from_int_field,
+    to_int_field,
+)
 from mission.procs.atomic import write_text_atomically
 from mission.world.frames import GeodeticFrame
 
@@ -58,44 +66,17 @@ class WaypointRow:
 
     def to_item(self) -> MissionItem:
         """As the vehicle stores it (MISSION_ITEM_INT: 1e-7 degrees)."""
-        global_frame = self.frame in GLOBAL_FRAMES
-        x = round(self.x * 1e7) if global_frame else round(self.x)
-        y = round(self.y * 1e7) if global_frame else round(self.y)
-        return MissionItem(
-            self.seq,
-            self.frame,
-            self.command,
-            self.current,
-            self.autocontinue,
-            self.param1,
-            self.param2,
-            self.param3,
-            self.param4,
-            x,
-            y,
-            self.z,
-        )
+        common = {name: getattr(self, name) for name, _ in COMMON_FIELDS}
+        x, y = to_int_field(self.x, self.frame), to_int_field(self.y, self.frame)
+        return MissionItem(**common, x=x, y=y)
 
     @classmethod
     def from_item(cls, item: MissionItem) -> WaypointRow:
         """From a downloaded item; float32 fields become the decimals they were written as."""
-        global_frame = item.frame in GLOBAL_FRAMES
-        scale = 1e7 if global_frame else 1.0
-        f = float32_decimal
-        return cls(
-            item.seq,
-            item.current,
-            item.frame,
-            item.command,
-            f(item.param1),
-            f(item.param2),
-            f(item.param3),
-            f(item.param4),
-            item.x / scale,
-            item.y / scale,
-            f(item.z),
-            item.autocontinue,
-        )
+        common = {name: getattr(item, name) for name, _ in COMMON_FIELDS}
+        common.update((name, float32_decimal(common[name])) for name in FLOAT32_FIELDS)
+        x, y = from_int_field(item.x, item.frame), from_int_field(item.y, item.frame)
+        return cls(**common, x=x, y=y)
 
 
 def format_waypoints(rows: list[WaypointRow]) -> str:
