@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import socket
+import time
 import types
 from collections import deque
 from pathlib import Path
@@ -212,3 +213,24 @@ def test_a_vehicle_is_lost_after_simulated_seconds_and_never_a_wall_moment(along
     assert _config(along, tmp_path).silence_limit_s == 3.0  # lockstep: 3 s of simulated time
     assert _config(along, tmp_path, speedup=0.5).silence_limit_s == 3.0  # 6 s of wall time
     assert _config(along, tmp_path, speedup=10.0).silence_limit_s == 20.0  # 2 s, not 0.3 s
+
+
+def test_a_ground_station_without_vehicles_says_what_it_waits_for_and_for_how_long(
+    along, tmp_path, capsys
+):
+    """Nothing listens at the vehicles' addresses: it says at once how long it will wait and
+    for which vehicles where, and after that names each one it never heard."""
+    from ground_station.links.vehicle_links import StationError
+    from ground_station.preflight import connect
+
+    silent = {n: ("127.0.0.1", 9) for n in NAMES}  # the discard port: nobody answers
+    station = GroundStation(KnownWorld.load("along"), _config(along, tmp_path, silent))
+    try:
+        started = time.monotonic()
+        with pytest.raises(StationError, match="no heartbeat from work, support-1, support-2"):
+            connect(station.links, 1.0)
+        assert time.monotonic() - started < 5.0
+    finally:
+        station.close()
+    said = capsys.readouterr().err
+    assert "ground station waiting up to 1 s for work 127.0.0.1:9, support-1 127.0.0.1:9" in said
