@@ -55,6 +55,11 @@ def add_parser(commands) -> None:
         default="all",
         help="of each run's folder: all; logs (all but G's snapshots); summary (and scenario)",
     )
+    parser.add_argument(
+        "--report-only",
+        action="store_true",
+        help="run nothing: write report.md, its figures (and Table 3) again from DIR's results.csv",
+    )
     parser.set_defaults(handler=study)
 
 
@@ -64,7 +69,22 @@ def study(args: argparse.Namespace) -> int:
 
     spec = load_study(args.file)
     out = args.out or Path("results") / spec.name
+    if args.report_only:
+        return _report_only(spec, out)
     return run_study_command(spec, out, args)
+
+
+def _report_only(spec, out: Path) -> int:
+    """``--report-only``: the report of ``out``'s results.csv, written again."""
+    from mission.studies.study import rewrite_report
+
+    results = out / "results.csv"
+    if not results.is_file():
+        raise InputError("command line", "--out", f"no results.csv in {out} to report on")
+    _check_study_outputs(out, None)
+    rows = rewrite_report(spec, out)
+    print(f"report of {rows} runs in {out / 'report.md'}")
+    return 0
 
 
 def run_study_command(spec, out: Path, args: argparse.Namespace) -> int:

@@ -56,6 +56,28 @@ def results_csv(spec: StudySpec, rows: list[dict]) -> str:
     return buffer.getvalue()
 
 
+def read_results_csv(text: str) -> list[dict]:
+    """The rows of a results.csv, each value as the summary held it: empty as None, True and
+    False as booleans, whole numbers as ints, other numbers as floats, the rest as text."""
+    return [
+        {key: _value(cell) for key, cell in row.items()}
+        for row in csv.DictReader(io.StringIO(text))
+    ]
+
+
+def _value(cell: str) -> Any:
+    if cell == "":
+        return None
+    if cell in ("True", "False"):
+        return cell == "True"
+    for kind in (int, float):
+        try:
+            return kind(cell)
+        except ValueError:
+            pass
+    return cell
+
+
 def _flatten(summary: dict[str, Any], prefix: str = ""):
     for key, value in summary.items():
         name = f"{prefix}{key}"

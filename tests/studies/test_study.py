@@ -13,7 +13,7 @@ from mission.studies import execute
 from mission.studies.results import inclusion_rate
 from mission.studies.runkeys import StudyRun
 from mission.studies.spec import Point, StudySpec
-from mission.studies.study import run_study
+from mission.studies.study import rewrite_report, run_study
 
 
 def _summary(run: StudyRun) -> dict:
@@ -160,3 +160,32 @@ def test_without_ray_the_ray_engine_says_in_one_line_how_to_install_it(
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "pip install -e '.[ray]'" in err[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
+
+
+def test_a_report_written_again_from_results_csv_is_the_report_the_study_wrote(tmp_path):
+    """``mission study --report-only``: from results.csv alone, the same report.md, Table 3
+    and figures, byte for byte; nothing runs."""
+    import mission.cli
+
+    spec = StudySpec(
+        "t", "A test.", Path("t.yaml"), ("along",), ("ac", "nac"), (0, 1, 2),
+        (Point((("map.eta", 0.3),)), Point((("map.eta", 0.6),))), ("table3",),
+    )  # fmt: skip
+    run_study(spec, tmp_path, FakeEngine(), progress=io.StringIO())
+
+    def reports() -> dict[str, bytes]:
+        return {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.suffix in (".md", ".csv")}
+
+    written = reports()
+    for name in written:
+        if name != "results.csv":
+            (tmp_path / name).unlink()
+    rewrite_report(spec, tmp_path)
+    again = reports()
+    assert again == written and "report.md" in again and "table.md" in again
+    study_file = tmp_path / "t.yaml"
+    study_file.write_text("name: t\nscenarios: [along]\nmethods: [ac]\nseeds: [0]\n")
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    argv = ["study", str(study_file), "--out", str(empty), "--report-only"]
+    assert mission.cli.entry_point(argv) == 2  # no results.csv: nothing to report on
