@@ -30,8 +30,10 @@ PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
 
 
 def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) -> None:
-    """report.md and its figures (in ``figures/``)."""
-    figures = write_figures(out_dir / "figures", spec, rows, METRICS)
+    """report.md and its figures (in ``figures/``); a metric no run has (a study made before
+    the metric existed) is left out of both."""
+    metrics = tuple(m for m in METRICS if any(r.get(m[0]) is not None for r in rows))
+    figures = write_figures(out_dir / "figures", spec, rows, metrics)
     lines = [f"# Study: {spec.name}", ""]
     if spec.description:
         lines += [spec.description, ""]
@@ -45,7 +47,7 @@ def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) 
         "",
         "## Per point and method",
         "",
-        *_means_table(spec, rows),
+        *_means_table(spec, rows, metrics),
     ]
     if set(spec.methods) == {"ac", "nac"}:
         lines += ["", "## AC against NAC, paired by seed", "", *_paired_table(spec, rows)]
@@ -64,18 +66,18 @@ def _groups(spec: StudySpec, rows: list[dict]):
                 yield scenario, point.label, mine
 
 
-def _means_table(spec: StudySpec, rows: list[dict]) -> list[str]:
+def _means_table(spec: StudySpec, rows: list[dict], metrics) -> list[str]:
     header = "| scenario | point | method | runs | completed | " + " | ".join(
-        label for _, label in METRICS
+        label for _, label in metrics
     )
-    lines = [header + " |", "|" + "---|" * (5 + len(METRICS))]
+    lines = [header + " |", "|" + "---|" * (5 + len(metrics))]
     for scenario, label, mine in _groups(spec, rows):
         for method in spec.methods:
             runs = [r for r in mine if r["method"] == method]
             if not runs:
                 continue
             done = sum(1 for r in runs if r.get("completed"))
-            cells = [_mean_cell(metric_values(runs, column)) for column, _ in METRICS]
+            cells = [_mean_cell(metric_values(runs, column)) for column, _ in metrics]
             lines.append(
                 f"| {scenario} | {label} | {method.upper()} | {len(runs)} | {done} | "
                 + " | ".join(cells)

@@ -80,6 +80,7 @@ def test_a_study_writes_its_results_and_report_and_a_rerun_skips_everything(tmp_
     # AC - NAC over seeds 0..2: time (250 + s) - (260 + 2 s) = -10, -11, -12
     assert "| along | map.eta=0.3 | 3 | -11.0 (-4.2 %) [-12.0, -10.0] (p = 0.25) |" in report
     assert (tmp_path / "figures" / "metrics-vs-map.eta.png").is_file()
+    assert "steps in multipath" in report and "closest approach" not in report  # none has it
     before = {p: p.read_bytes() for p in (tmp_path / "results.csv", tmp_path / "report.md")}
     progress = io.StringIO()
     again = run_study(_spec(), tmp_path, FakeEngine(), progress=progress)
