@@ -150,25 +150,34 @@ def test_the_half_spaces_are_those_of_their_definition(structure, write_scenario
         )
 
 
+YHAT = np.array([-6.0, 12.0, 8.5])  # support 1 in the open, beside the bridge
+
+
+def _beside_the_bridge(world: World, mpc: SupportMpc, parked, terminal=None):
+    """Support 1's request at YHAT, every waypoint there (the terminal one at ``terminal`` if
+    given), support 2 parked at ``parked`` and support 3 far off."""
+    plan_ = read_plan(world.scenario)
+    horizon = world.scenario.control.horizon_steps
+    work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
+    waypoints = np.repeat([YHAT], 15, axis=0)
+    if terminal is not None:
+        waypoints[work.indices[horizon]] = terminal  # also the target of the later steps
+    still = np.repeat([parked], horizon, axis=0)
+    others = np.array([work.path[:horizon], still, still + [0.0, 30.0, 0.0]])
+    return mpc.request(
+        "support-1", YHAT, waypoints, work.path, work.indices, world.sigma0_map().sigma_m,
+        others=others,
+    )  # fmt: skip
+
+
 def test_near_is_not_solved_where_far_beats_what_its_slacks_must_cost(worlds, monkeypatch):
     """A terminal waypoint inside another UAV's margin: near would have to break it (fatrop
     stalls on that problem); far, solved first, costs less than near's slacks at least would,
     and near is never solved."""
     safe, _ = worlds
     mpc = _mpc(safe, 3)
-    plan_ = read_plan(safe.scenario)
-    horizon = safe.scenario.control.horizon_steps
-    yhat = np.array([-6.0, 12.0, 8.5])  # in the open, beside the bridge
-    work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
-    terminal = work.indices[horizon]  # also the target of the later steps
-    waypoints = np.repeat([yhat], 15, axis=0)
-    waypoints[terminal] = yhat + [2.8, 0.0, 0.0]  # where support 2 is parked
-    parked = np.repeat([waypoints[terminal]], horizon, axis=0)
-    others = np.array([work.path[:horizon], parked, parked + [0.0, 30.0, 0.0]])
-    request = mpc.request(
-        "support-1", yhat, waypoints, work.path, work.indices, safe.sigma0_map().sigma_m,
-        others=others,
-    )  # fmt: skip
+    parked = YHAT + [2.8, 0.0, 0.0]  # support 2, on the terminal waypoint
+    request = _beside_the_bridge(safe, mpc, parked, terminal=parked)
     solved = []
     solve_branch = SupportMpc._solve_branch
 
@@ -219,17 +228,8 @@ def test_a_margin_out_of_reach_goes_straight_to_the_soft_form(worlds, monkeypatc
     no more than it must (it flies straight away from the other UAV)."""
     safe, _ = worlds
     mpc = _mpc(safe, 3)
-    plan_ = read_plan(safe.scenario)
-    horizon = safe.scenario.control.horizon_steps
-    yhat = np.array([-6.0, 12.0, 8.5])  # in the open, beside the bridge
-    work = predict_work(plan_.work[6], 6, plan_.work, horizon, 0.3, 0.1)
-    waypoints = np.repeat([yhat], 15, axis=0)
-    parked = np.repeat([yhat + [0.0, -0.5, 0.0]], horizon, axis=0)
-    others = np.array([work.path[:horizon], parked, parked + [0.0, 30.0, 0.0]])
-    request = mpc.request(
-        "support-1", yhat, waypoints, work.path, work.indices, safe.sigma0_map().sigma_m,
-        others=others,
-    )  # fmt: skip
+    parked = YHAT + [0.0, -0.5, 0.0]
+    request = _beside_the_bridge(safe, mpc, parked)
     solved = _forms_solved(monkeypatch)
     planned = mpc.plan(request, safe.camera.observable)
     assert planned.status == CONVERGED and solved and all(f.endswith(SOFT) for f in solved)
