@@ -27,6 +27,8 @@ from vehicle_sim.contact import Contact, ContactDetector, ContactWatch, as_sent
 from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
+from vehicle_sim.param_server import ParamServer
+from vehicle_sim.parameters import vehicle_parameters
 
 GCS_SYSTEM_ID = 255
 SENSOR_STREAMS = (
@@ -106,6 +108,8 @@ class Vehicle:
             retries=vs.mission_retries,
             capacity=vs.mission_capacity,
         )
+        table = vehicle_parameters(scenario, self.speed_limit_m_s, speedup)
+        self.params = ParamServer(table, self.send, self.notify)
 
     # -- outgoing ---------------------------------------------------------------------------
     def notify(self, severity: int, text: str) -> None:
@@ -215,7 +219,7 @@ class Vehicle:
     def _check_failsafe(self) -> None:
         if not (self.armed and self.mode == modes.GUIDED) or self.failsafe:
             return
-        limit = self.scenario.vehicle.failsafe_s
+        limit = self.params.table.value("FS_GCS_TIMEOUT")  # the scenario's, unless set
         if self.sim_time_s - self._last_setpoint_s >= limit - 1e-9:
             self.failsafe = True
             self.kinematics.hold()
@@ -265,7 +269,7 @@ class Vehicle:
         if target not in (0, self.identity.system_id):
             self.counters.reject("for another system")
             return
-        if self.mission.handle(msg, wall_now):
+        if self.mission.handle(msg, wall_now) or self.params.handle(msg):
             return
         handler = self._HANDLERS.get(msg.get_type())
         if handler is not None:

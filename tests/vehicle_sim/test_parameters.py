@@ -1,0 +1,111 @@
+"""The parameter protocol against a real vehicle process, with pymavlink as the peer: the whole
+list once, reads by index and by id, a set echoed, refusals echoed unchanged and said why."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
+
+from tests.mav_client import MavClient
+from tests.processes import vehicle_process
+
+pytestmark = pytest.mark.slow  # a vehicle process
+SYSID = 2  # support-1
+
+
+@pytest.fixture(scope="module")
+def vehicle():
+    with vehicle_process("support-1", "--speedup", "1") as running:
+        yield running
+
+
+@pytest.fixture
+def client(vehicle):
+    mav = MavClient(vehicle.address)
+    yield mav
+    mav.close()
+
+
+def _download(client: MavClient) -> dict[int, object]:
+    client.send(mavlink2.MAVLink_param_request_list_message(SYSID, 1))
+    values: dict[int, object] = {}
+    deadline = time.monotonic() + 5.0
+    while time.monotonic() < deadline:
+        got = client.wait_for("PARAM_VALUE", timeout_s=deadline - time.monotonic())
+        assert got is not None, f"{len(values)} parameters came"
+        values.setdefault(got.param_index, got)
+        if len(values) == got.param_count:
+            return values
+    raise AssertionError("the list did not complete")
+
+
+def _read(client: MavClient, name: str = "", index: int = -1):
+    request = mavlink2.MAVLink_param_request_read_message(SYSID, 1, name.encode(), index)
+    client.send(request)
+    return client.wait_for("PARAM_VALUE", timeout_s=2.0)
+
+
+def _set(client: MavClient, name: str, value: float, kind=mavlink2.MAV_PARAM_TYPE_REAL32):
+    client.send(mavlink2.MAVLink_param_set_message(SYSID, 1, name.encode(), value, kind))
+    return client.wait_for("PARAM_VALUE", timeout_s=2.0, where=lambda m: m.param_id == name)
+
+
+def test_the_whole_list_comes_once_in_under_half_a_second(client):
+    started = time.monotonic()
+    values = _download(client)
+    assert time.monotonic() - started < 0.5
+    count = next(iter(values.values())).param_count
+    assert sorted(values) == list(range(count))
+    names = [v.param_id for v in values.values()]
+    assert len(set(names)) == count and all(0 < len(n) <= 16 for n in names)
+    assert {"FS_GCS_TIMEOUT", "SIM_SPEEDUP", "WPNAV_SPEED"} <= set(names)
+
+    def table(download):
+        return [(i, v.param_id, v.param_type) for i, v in sorted(download.items())]
+
+    assert table(_download(client)) == table(values)  # the table does not change once read
+
+
+def test_a_parameter_reads_the_same_by_index_and_by_id(client):
+    by_name = _read(client, "WPNAV_SPEED")
+    assert by_name is not None and by_name.param_value == pytest.approx(100.0)  # cm/s
+    by_index = _read(client, index=by_name.param_index)
+    assert (by_index.param_id, by_index.param_value) == ("WPNAV_SPEED", by_name.param_value)
+
+
+def test_a_set_is_echoed_and_kept(client):
+    echo = _set(client, "FS_GCS_TIMEOUT", 7.5)
+    assert echo is not None and echo.param_value == 7.5
+    assert _read(client, "FS_GCS_TIMEOUT").param_value == 7.5
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "kind", "reason"),
+    [
+        ("SIM_SPEEDUP", 10.0, mavlink2.MAV_PARAM_TYPE_REAL32, "the run's clock"),
+        ("FS_GCS_TIMEOUT", math.nan, mavlink2.MAV_PARAM_TYPE_REAL32, "finite"),
+        ("FS_GCS_TIMEOUT", 1e6, mavlink2.MAV_PARAM_TYPE_REAL32, "must be in"),
+        ("FS_GCS_TIMEOUT", 5.0, mavlink2.MAV_PARAM_TYPE_INT32, "type"),
+    ],
+    ids=["read-only", "nan", "out-of-range", "wrong-type"],
+)
+def test_a_refused_set_is_echoed_unchanged_and_said_why(client, name, value, kind, reason):
+    before = _read(client, name).param_value
+    echo = _set(client, name, value, kind)
+    assert echo is not None and echo.param_value == before
+    said = _said(client, name)
+    assert said and reason in said[-1], said
+
+
+def test_an_unknown_id_is_said_and_gets_no_value(client):
+    assert _set(client, "NO_SUCH_PARAM", 1.0) is None
+    assert _said(client, "NO_SUCH_PARAM")
+
+
+def _said(client: MavClient, name: str) -> list[str]:
+    """The STATUSTEXTs about ``name`` that have come (before or after its echo)."""
+    client.collect(0.2)
+    return [m.text for m in client.seen if m.get_type() == "STATUSTEXT" and name in m.text]
