@@ -4,7 +4,8 @@ PARAM_REQUEST_LIST sends every parameter once, with its index and the count; PAR
 answers by index, or by id when the index is -1; PARAM_SET is always answered with the
 parameter's PARAM_VALUE, the new value or, refused, the unchanged one, with a STATUSTEXT
 saying why. A read or set of an id the vehicle does not have gets a STATUSTEXT and no value
-(there is none to give), as a request of an index out of range gets nothing.
+(there is none to give), as a request of an index out of range gets nothing. MAVLink FTP
+gets a NAK at once (:mod:`~vehicle_sim.ftp_server`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from vehicle_sim.ftp_server import answer_ftp
 from vehicle_sim.parameters import ParameterTable
 
 
@@ -42,6 +44,8 @@ class ParamServer:
                 self._send(self.table.value_message(index))
         elif kind == "PARAM_SET":
             self._set(msg)
+        elif kind == "FILE_TRANSFER_PROTOCOL":
+            answer_ftp(msg, self._send)
         else:
             return False
         return True

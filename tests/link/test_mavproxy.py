@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -25,9 +26,14 @@ from tests.mav_client import MavClient
 from tests.processes import stop_process, vehicle_process
 
 pytestmark = pytest.mark.slow  # every test here starts processes
+RECEIVED = re.compile(r"Received \d+ parameters")
 
 
-def _mavproxy(port: int, command: str, cwd: Path) -> tuple[subprocess.Popen, list[str]]:
+def _mavproxy(
+    port: int, command: str, cwd: Path, modules: str = "wp", commands_later: bool = False
+) -> tuple[subprocess.Popen, list[str]]:
+    """MAVProxy at a vehicle running ``command``; with ``commands_later`` it also reads more
+    commands from its stdin (a pipe)."""
     executable = shutil.which("mavproxy.py") or str(Path(sys.executable).parent / "mavproxy.py")
     process = subprocess.Popen(
         [
@@ -35,12 +41,12 @@ def _mavproxy(port: int, command: str, cwd: Path) -> tuple[subprocess.Popen, lis
             executable,
             f"--master=udpout:127.0.0.1:{port}",
             "--target-system=2",
-            "--non-interactive",
+            *([] if commands_later else ["--non-interactive"]),
             "--no-state",
-            "--default-modules=wp",
+            f"--default-modules={modules}",
             f"--cmd={command}",
         ],
-        stdin=subprocess.DEVNULL,
+        stdin=subprocess.PIPE if commands_later else subprocess.DEVNULL,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -82,3 +88,25 @@ def test_mavproxy_loads_and_lists_a_waypoint_file(along, tmp_path):
     for fields, row in zip(listed, read_waypoints(path)):
         assert float(fields[2]) == row.x and float(fields[3]) == row.y
         assert float(fields[4]) == row.z
+
+
+def test_mavproxy_fetches_and_shows_the_parameters_after_its_ftp_attempt(tmp_path):
+    """MAVProxy with its ftp module asks for ``@PARAM/param.pck`` first; the vehicle's NAK
+    sends it to the parameter protocol at once, and ``param show`` lists the vehicle's
+    parameters with their values."""
+    with vehicle_process("support-1", "--speedup", "1") as vehicle:
+        shower, lines = _mavproxy(
+            vehicle.port, "param fetch", tmp_path, modules="param,ftp", commands_later=True
+        )
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline and not any(RECEIVED.search(x) for x in lines):
+            time.sleep(0.2)
+        assert shower.stdin is not None
+        shower.stdin.write("param show SIM_*\nparam show WPNAV_SPEED\n")
+        shower.stdin.flush()
+        while time.monotonic() < deadline and not any("WPNAV_SPEED" in x for x in lines):
+            time.sleep(0.2)
+        stop_process(shower)
+    assert any("parameter list (ftp)" in x for x in lines), "MAVProxy tried FTP first"
+    shown = {x.split()[0]: x.split()[1] for x in lines if x.startswith(("SIM_", "WPNAV_"))}
+    assert float(shown["WPNAV_SPEED"]) == 100.0 and float(shown["SIM_SPEEDUP"]) == 1.0, lines
