@@ -17,6 +17,13 @@ def _hostile_messages(rng: np.random.Generator, count: int) -> list:
     """Well-formed packets (valid CRC) whose contents are nonsense."""
     f = lambda: float(rng.choice(HOSTILE_FLOATS))  # noqa: E731
     u = lambda bits: int(rng.integers(0, 2**bits, dtype=np.uint64))  # noqa: E731
+
+    def param_id() -> bytes:
+        """A real parameter's id half the time, else 16 random bytes."""
+        if rng.random() < 0.5:
+            return b"FS_GCS_TIMEOUT"
+        return rng.integers(0, 256, 16, dtype=np.uint8).tobytes()
+
     makers = [
         lambda: mavlink2.MAVLink_set_position_target_local_ned_message(
             u(32), 2, 1, u(8), u(16), f(), f(), f(), f(), f(), f(), f(), f(), f(), f(), f()
@@ -53,6 +60,12 @@ def _hostile_messages(rng: np.random.Generator, count: int) -> list:
         lambda: mavlink2.MAVLink_set_mode_message(2, u(8), u(32)),
         lambda: mavlink2.MAVLink_system_time_message(u(64), u(32)),
         lambda: mavlink2.MAVLink_timesync_message(u(63), u(63)),
+        lambda: mavlink2.MAVLink_param_set_message(2, 1, param_id(), f(), u(8)),
+        lambda: mavlink2.MAVLink_param_request_read_message(2, 1, param_id(), u(16) - 2**15),
+        lambda: mavlink2.MAVLink_param_request_list_message(2, 1),
+        lambda: mavlink2.MAVLink_file_transfer_protocol_message(
+            u(8), 2, 1, list(rng.integers(0, 256, 251, dtype=np.uint8).tobytes())
+        ),
     ]
     return [makers[int(rng.integers(len(makers)))]() for _ in range(count)]
 
