@@ -8,7 +8,9 @@ from typing import Any, Protocol
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from vehicle_sim import modes
+from vehicle_sim.failures import SensorFailures
 from vehicle_sim.mission_server import MissionServer
+from vehicle_sim.param_server import ParamServer
 
 
 class Vehicle(Protocol):
@@ -22,6 +24,10 @@ class Vehicle(Protocol):
     def change_mode(self, mode: int) -> None: ...
     def set_interval(self, message_id: int, interval_us: float) -> bool: ...
     def build_stream(self, message_id: int, work_truth: Any = None) -> Any: ...
+    def notify(self, severity: int, text: str) -> None: ...
+
+    failures: SensorFailures
+    params: ParamServer
 
 
 ACCEPTED = mavlink2.MAV_RESULT_ACCEPTED
@@ -97,7 +103,25 @@ def _request_message(vehicle: Vehicle, params: list[float]) -> int:
         return UNSUPPORTED
     if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
         return DENIED  # a camera sample needs the step's truth; it comes with the stream
-    vehicle.send(vehicle.build_stream(message_id))
+    message = vehicle.build_stream(message_id)
+    if message is None:
+        return FAILED  # the sensor is failed off
+    vehicle.send(message)
+    return ACCEPTED
+
+
+def _inject_failure(vehicle: Vehicle, params: list[float]) -> int:
+    """MAV_CMD_INJECT_FAILURE: param1 the unit, param2 the type (vehicle_sim.failures)."""
+    if math.isnan(params[0]) or math.isnan(params[1]):
+        return DENIED
+    if not vehicle.params.table.value("SIM_FAIL_ENABLE"):
+        return DENIED  # failure injection is off, as PX4's SYS_FAILURE_EN gates it
+    unit, kind = int(params[0]), int(params[1])
+    if not vehicle.failures.inject(unit, kind):
+        return UNSUPPORTED
+    unit_name = "GPS" if unit == mavlink2.FAILURE_UNIT_SENSOR_GPS else "camera"
+    kind_name = mavlink2.enums["FAILURE_TYPE"][kind].name.removeprefix("FAILURE_TYPE_")
+    vehicle.notify(mavlink2.MAV_SEVERITY_WARNING, f"Failure injected: {unit_name} {kind_name}")
     return ACCEPTED
 
 
@@ -121,4 +145,5 @@ _COMMANDS = {
     mavlink2.MAV_CMD_REQUEST_MESSAGE: _request_message,
     mavlink2.MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES: _request_capabilities,
     mavlink2.MAV_CMD_DO_SET_MISSION_CURRENT: _set_mission_current,
+    mavlink2.MAV_CMD_INJECT_FAILURE: _inject_failure,
 }

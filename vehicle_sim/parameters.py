@@ -121,6 +121,7 @@ def vehicle_parameters(scenario: Scenario, speed_m_s: float, speedup: float) -> 
         Parameter("SIM_GPS_UERE", REAL32, scenario.gnss.sigma_uere_m, 0, 100),
         Parameter("SIM_CAM_RANGE", REAL32, scenario.camera.range_m, 0, 1000),
         Parameter("SIM_RADIUS", REAL32, v.radius_m, 0, 10),
+        Parameter("SIM_FAIL_ENABLE", INT32, 0, 0, 1, None),  # MAV_CMD_INJECT_FAILURE allowed
         Parameter("SIM_TRACK_NOISE", REAL32, v.tracking_noise_m, 0, 10),
     ]
     return ParameterTable(sorted(rows, key=lambda p: p.name))

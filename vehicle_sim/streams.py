@@ -13,7 +13,8 @@ from vehicle_sim import telemetry
 
 def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -> Any:
     """Build one message of a stream for the current state of ``vehicle`` (a
-    :class:`~vehicle_sim.vehicle.Vehicle`, which calls this)."""
+    :class:`~vehicle_sim.vehicle.Vehicle`, which calls this); None where a failed sensor
+    publishes nothing (:mod:`~vehicle_sim.failures`)."""
     k = vehicle.kinematics
     if message_id == mavlink2.MAVLINK_MSG_ID_SIM_STATE:
         return telemetry.sim_state(k.truth, k.velocity, vehicle.frame)
@@ -26,11 +27,14 @@ def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -
     if message_id == mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT:
         offset = vehicle.world.zone_offset(k.truth[None])[0]
         fix = vehicle.world.gnss.sample_fix(k.truth, vehicle.rng_gnss, offset)
-        return telemetry.gps_raw_int(
+        healthy = telemetry.gps_raw_int(
             fix, vehicle.frame, vehicle.time_unix_usec, vehicle.scenario.gnss.sigma_uere_m
         )
+        return vehicle.failures.filter(message_id, healthy)
     if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
-        return telemetry.landing_target(vehicle.observe(work_truth), vehicle.time_unix_usec, 1)
+        observed = vehicle.observe(work_truth)
+        healthy = telemetry.landing_target(observed, vehicle.time_unix_usec, 1)
+        return vehicle.failures.filter(message_id, healthy)
     if message_id == mavlink2.MAVLINK_MSG_ID_HEARTBEAT:
         return vehicle.heartbeat()
     if message_id == mavlink2.MAVLINK_MSG_ID_SYS_STATUS:

@@ -24,6 +24,7 @@ from mission.world.proximity import StructureProximity
 from vehicle_sim import modes, streams, telemetry
 from vehicle_sim.commands import execute, set_mode
 from vehicle_sim.contact import Contact, ContactDetector, ContactWatch, as_sent
+from vehicle_sim.failures import SensorFailures
 from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
@@ -64,9 +65,10 @@ class Vehicle:
         self.frame = GeodeticFrame(scenario.world.anchor)
         self.home = np.asarray(home_enu, dtype=float).reshape(3)
         self.send = send
-        gnss_seed, camera_seed, motion_seed = np.random.SeedSequence(
+        # the fourth child is new: the first three are what they always were
+        gnss_seed, camera_seed, motion_seed, failure_seed = np.random.SeedSequence(
             [seed, identity.instance]
-        ).spawn(3)
+        ).spawn(4)
         self.rng_gnss = np.random.default_rng(gnss_seed)
         self.rng_camera = np.random.default_rng(camera_seed)
         self.rng_motion = np.random.default_rng(motion_seed)
@@ -108,6 +110,7 @@ class Vehicle:
             retries=vs.mission_retries,
             capacity=vs.mission_capacity,
         )
+        self.failures = SensorFailures(failure_seed, vs.sensor_hz)
         table = vehicle_parameters(scenario, self.speed_limit_m_s, speedup)
         self.params = ParamServer(table, self.send, self.notify)
 
@@ -140,7 +143,9 @@ class Vehicle:
         due = {m for m, interval in self.intervals_s.items() if self._due(m, interval)}
         for message_id in (*SENSOR_STREAMS, *STATUS_STREAMS):
             if message_id in due:
-                self.send(self.build_stream(message_id, work_truth))
+                message = self.build_stream(message_id, work_truth)
+                if message is not None:  # None: a failed sensor publishes nothing
+                    self.send(message)
                 self._last_sent_s[message_id] = self.sim_time_s
         self.send(mavlink2.MAVLink_system_time_message(self.time_unix_usec, self.time_boot_ms))
 
