@@ -102,17 +102,22 @@ class Vehicle:
             del self.intervals_s[mavlink2.MAVLINK_MSG_ID_LANDING_TARGET]
         self._default_intervals = dict(self.intervals_s)
         self._last_sent_s: dict[int, float] = {}
-        self.mission = MissionServer(
-            (identity.system_id, 1),
+        self.failures = SensorFailures(failure_seed, vs.sensor_hz)
+        self.mission, self.params = self._protocol_servers(speedup)
+
+    def _protocol_servers(self, speedup: float) -> tuple[MissionServer, ParamServer]:
+        """The mission protocol's server and the parameter protocol's."""
+        vs = self.scenario.vehicle
+        mission = MissionServer(
+            (self.identity.system_id, 1),
             self.send,
             self.notify,
             timeout_s=vs.mission_timeout_wall_s / speedup,
             retries=vs.mission_retries,
             capacity=vs.mission_capacity,
         )
-        self.failures = SensorFailures(failure_seed, vs.sensor_hz)
-        table = vehicle_parameters(scenario, self.speed_limit_m_s, speedup)
-        self.params = ParamServer(table, self.send, self.notify)
+        table = vehicle_parameters(self.scenario, self.speed_limit_m_s, speedup)
+        return mission, ParamServer(table, self.send, self.notify)
 
     # -- outgoing ---------------------------------------------------------------------------
     def notify(self, severity: int, text: str) -> None:
