@@ -27,10 +27,13 @@ class ParamServer:
         table: ParameterTable,
         send: Callable[[Any], None],
         notify: Callable[[int, str], None],
+        on_change: Callable[[str, float], None] = lambda name, value: None,
     ) -> None:
+        """``on_change(name, value)`` applies a value once it is set."""
         self.table = table
         self._send = send
         self._notify = notify
+        self._on_change = on_change
 
     def handle(self, msg: Any) -> bool:
         """Act on ``msg`` if it is a parameter message (True), else leave it (False)."""
@@ -57,7 +60,10 @@ class ParamServer:
         name = self.table[index].name
         refusal = self.table.refusal(index, float(msg.param_value), int(msg.param_type))
         if refusal is None:
-            self.table.set(index, float(msg.param_value))
+            value = float(msg.param_value)
+            self.table.set(index, value)
+            self._on_change(name, value)
+            self._notify(mavlink2.MAV_SEVERITY_INFO, f"{name} set to {value:g}")
         else:
             self._notify(mavlink2.MAV_SEVERITY_WARNING, f"{name} not set: {refusal}")
         self._send(self.table.value_message(index))

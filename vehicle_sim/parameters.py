@@ -116,7 +116,7 @@ def vehicle_parameters(scenario: Scenario, speed_m_s: float, speedup: float) -> 
         Parameter("SIM_RATE_HZ", INT32, round(1 / step_s), 1, 10000),
         # the simulation's
         Parameter("SIM_SPEEDUP", REAL32, speedup, 0.1, 1000, "the run's clock: --speedup"),
-        Parameter("SIM_GPS1_ENABLE", INT32, 1, 0, 1),
+        Parameter("SIM_GPS1_ENABLE", INT32, 1, 0, 1, None),  # live: 0 is a GNSS failed off
         Parameter("SIM_GPS1_HZ", INT32, round(v.sensor_hz), 1, 100),
         Parameter("SIM_GPS_UERE", REAL32, scenario.gnss.sigma_uere_m, 0, 100),
         Parameter("SIM_CAM_RANGE", REAL32, scenario.camera.range_m, 0, 1000),

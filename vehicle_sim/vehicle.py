@@ -21,7 +21,7 @@ from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
 from mission.world.proximity import StructureProximity
-from vehicle_sim import modes, streams, telemetry
+from vehicle_sim import failures, modes, streams, telemetry
 from vehicle_sim.commands import execute, set_mode
 from vehicle_sim.contact import Contact, ContactDetector, ContactWatch, as_sent
 from vehicle_sim.failures import SensorFailures
@@ -117,7 +117,13 @@ class Vehicle:
             capacity=vs.mission_capacity,
         )
         table = vehicle_parameters(self.scenario, self.speed_limit_m_s, speedup)
-        return mission, ParamServer(table, self.send, self.notify)
+        return mission, ParamServer(table, self.send, self.notify, self._parameter_set)
+
+    def _parameter_set(self, name: str, value: float) -> None:
+        """A parameter set live takes effect (before the next step)."""
+        if name == "SIM_GPS1_ENABLE":  # as ArduPilot's: 0 turns the receiver off
+            kind = failures.OK if value else failures.OFF
+            self.failures.inject(failures.GPS, kind)
 
     # -- outgoing ---------------------------------------------------------------------------
     def notify(self, severity: int, text: str) -> None:

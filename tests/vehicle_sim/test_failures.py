@@ -78,3 +78,19 @@ def test_gnss_off_stuck_wrong_and_back(client):
     client.collect(0.3)
     back = _fixes(client, 1.0)
     assert len(back) >= 3 and abs(back[:, 0].mean() - healthy[:, 0].mean()) * 0.0111 < 1.5
+
+
+def test_sim_gps1_enable_turns_the_receiver_off_and_on_as_ardupilot_s_does(client):
+    """No failure-injection gate: a parameter set, said in a STATUSTEXT (so the tlog has it)."""
+    for value, publishing in ((0, False), (1, True)):
+        client.send(
+            mavlink2.MAVLink_param_set_message(
+                SYSID, 1, b"SIM_GPS1_ENABLE", value, mavlink2.MAV_PARAM_TYPE_INT32
+            )
+        )
+        echo = client.wait_for("PARAM_VALUE", where=lambda m: m.param_id == "SIM_GPS1_ENABLE")
+        assert echo is not None and echo.param_value == value
+        client.collect(0.3)
+        assert (len(_fixes(client, 1.0)) > 0) == publishing
+    said = [m.text for m in client.seen if m.get_type() == "STATUSTEXT"]
+    assert "SIM_GPS1_ENABLE set to 0" in said and "SIM_GPS1_ENABLE set to 1" in said
