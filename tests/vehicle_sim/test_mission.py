@@ -46,13 +46,6 @@ def vehicle(scenario_file):
         yield running
 
 
-@pytest.fixture
-def client(vehicle):
-    mav = MavClient(vehicle.address)
-    yield mav
-    mav.close()
-
-
 def _rows(items: list[MissionItem]) -> list[WaypointRow]:
     """Compare missions as their file rows (float32 fields back to their decimals)."""
     return [WaypointRow.from_item(item) for item in items]

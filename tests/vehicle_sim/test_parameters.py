@@ -22,13 +22,6 @@ def vehicle():
         yield running
 
 
-@pytest.fixture
-def client(vehicle):
-    mav = MavClient(vehicle.address)
-    yield mav
-    mav.close()
-
-
 def _download(client: MavClient) -> dict[int, object]:
     client.send(mavlink2.MAVLink_param_request_list_message(SYSID, 1))
     values: dict[int, object] = {}
