@@ -76,9 +76,7 @@ class Margins:
             self.slots,
         )
         function = half_spaces_function(rules, self._horizon)
-        if compiled:
-            function = compiled_function(function)
-        return BufferedFunction(function, ("spaces", "inside"))
+        return BufferedFunction(compiled_function(function, compiled), ("spaces", "inside"))
 
     def parameters(self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray) -> np.ndarray:
         """The NLP's margin parameters for a guess (U, 3): every step's normals (column by

@@ -109,7 +109,7 @@ class SupportMpc:
         structure = camera.structure
         if structure is None:
             raise ValueError("the support MPC needs the camera's structure for its margins")
-        self.margins = Margins(control, structure, others)
+        self.margins = Margins(control, structure, others, compiled)
         slots = self.margins.slots
         nlp = build_support_nlp(control, self._window_grid, with_prior, compiled, slots)
         self._solvers, self._cost = nlp.solvers, nlp.cost

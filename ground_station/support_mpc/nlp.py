@@ -30,7 +30,6 @@ so the solver gets exact second derivatives.
 from __future__ import annotations
 
 import contextlib
-import tempfile
 from dataclasses import dataclass
 
 import casadi as ca
@@ -38,7 +37,7 @@ import numpy as np
 
 from ground_station.gnss_map import inlined_hermite
 from ground_station.support_mpc.casadi_buffer import BufferedFunction
-from ground_station.support_mpc.nlp_cache import NlpBuild, compiled_nlps
+from ground_station.support_mpc.nlp_cache import NlpBuild, compiled_libraries
 from mission.config.settings import ControlSettings
 from mission.world.grid import VoxelGrid
 
@@ -229,16 +228,10 @@ def _solvers(
         NlpBuild(f"support_mpc_{branch}", plugin, nlp, options) for branch, nlp in nlps.items()
     ]
     solvers = {}
-    with contextlib.ExitStack() as scratch:  # for libraries the cache cannot take
-
-        def private_directory() -> str:
-            return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
-
-        libraries = compiled_nlps(builds, private_directory) if compiled else [None] * len(builds)
+    interpreted = contextlib.nullcontext([None] * len(builds))
+    with compiled_libraries(builds) if compiled else interpreted as libraries:
         for branch, build, library in zip(nlps, builds, libraries, strict=True):
             loaded = build.nlp if library is None else library
             solver = ca.nlpsol(build.name, plugin, loaded, options)
             solvers[branch] = BufferedFunction(solver, ("x", "f"), unbounded)
-    # casadi has loaded the libraries: their files may go (no clean-up left for the exit,
-    # which a forked helper makes with os._exit)
     return solvers

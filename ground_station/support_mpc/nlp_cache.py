@@ -17,7 +17,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -119,16 +119,25 @@ def compiled_nlps(
     return libraries
 
 
-def compiled_function(function: ca.Function) -> ca.Function:
-    """``function`` compiled (and cached) and loaded, or itself, interpreted, without a C
-    compiler."""
-    with contextlib.ExitStack() as scratch:  # for a library the cache cannot take
+@contextlib.contextmanager
+def compiled_libraries(builds: list[NlpBuild | FunctionBuild]) -> Iterator[list[str | None]]:
+    """:func:`compiled_nlps` with a private scratch folder for the libraries the cache cannot
+    take, gone on leaving: load them inside. Once casadi has loaded a library its file may go
+    (no clean-up is left for the exit, which a forked helper makes with os._exit)."""
+    with contextlib.ExitStack() as scratch:
 
         def private_directory() -> str:
             return scratch.enter_context(tempfile.TemporaryDirectory(prefix="support-mpc-"))
 
-        (library,) = compiled_nlps([FunctionBuild(function)], private_directory)
-        # loaded, the library's file may go
+        yield compiled_nlps(builds, private_directory)
+
+
+def compiled_function(function: ca.Function, compiled: bool = True) -> ca.Function:
+    """``function`` compiled (and cached) and loaded, or itself, interpreted, without a C
+    compiler or when ``compiled`` is False."""
+    if not compiled:
+        return function
+    with compiled_libraries([FunctionBuild(function)]) as (library,):
         return function if library is None else ca.external(function.name(), library)
 
 
