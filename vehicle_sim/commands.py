@@ -8,7 +8,6 @@ from typing import Any, Protocol
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from vehicle_sim import modes
-from vehicle_sim.failures import SensorFailures
 from vehicle_sim.mission_server import MissionServer
 from vehicle_sim.param_server import ParamServer
 
@@ -25,8 +24,8 @@ class Vehicle(Protocol):
     def set_interval(self, message_id: int, interval_us: float) -> bool: ...
     def build_stream(self, message_id: int, work_truth: Any = None) -> Any: ...
     def notify(self, severity: int, text: str) -> None: ...
+    def inject_failure(self, unit: int, kind: int) -> bool: ...
 
-    failures: SensorFailures
     params: ParamServer
 
 
@@ -116,12 +115,8 @@ def _inject_failure(vehicle: Vehicle, params: list[float]) -> int:
         return DENIED
     if not vehicle.params.table.value("SIM_FAIL_ENABLE"):
         return DENIED  # failure injection is off, as PX4's SYS_FAILURE_EN gates it
-    unit, kind = int(params[0]), int(params[1])
-    if not vehicle.failures.inject(unit, kind):
+    if not vehicle.inject_failure(int(params[0]), int(params[1])):
         return UNSUPPORTED
-    unit_name = "GPS" if unit == mavlink2.FAILURE_UNIT_SENSOR_GPS else "camera"
-    kind_name = mavlink2.enums["FAILURE_TYPE"][kind].name.removeprefix("FAILURE_TYPE_")
-    vehicle.notify(mavlink2.MAV_SEVERITY_WARNING, f"Failure injected: {unit_name} {kind_name}")
     return ACCEPTED
 
 

@@ -39,6 +39,9 @@ STREAM_OF = {
     GPS: mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT,
     CAMERA: mavlink2.MAVLINK_MSG_ID_LANDING_TARGET,
 }
+UNIT_NAMES = {GPS: "gps", CAMERA: "camera"}
+KIND_NAMES = {OK: "ok", OFF: "off", STUCK: "stuck", GARBAGE: "garbage", WRONG: "wrong"}
+KIND_NAMES[DELAYED] = "delayed"
 WRONG_NORTH_M = 10.0
 WRONG_ANGLE_RAD = 0.1
 DELAY_S = 1.0
@@ -96,6 +99,19 @@ class SensorFailures:
             failed.y = message.x * turn_sin + message.y * turn_cos
             failed.angle_x = message.angle_x + WRONG_ANGLE_RAD
         return failed
+
+
+def failure_name(unit: int, kind: int) -> str:
+    """``UNIT TYPE`` as a scenario's ``faults:`` and the event STATUSTEXT spell it."""
+    return f"{UNIT_NAMES.get(unit, str(unit))} {KIND_NAMES.get(kind, str(kind))}"
+
+
+def parse_failure(name: str) -> tuple[int, int]:
+    """(unit, type) of ``UNIT TYPE`` (KeyError: not one of ours)."""
+    unit, _, kind = name.partition(" ")
+    units = {v: k for k, v in UNIT_NAMES.items()}
+    kinds = {v: k for k, v in KIND_NAMES.items()}
+    return units[unit], kinds[kind]
 
 
 def _restamped(message: Any | None, time_usec: int) -> Any | None:

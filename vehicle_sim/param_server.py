@@ -2,10 +2,10 @@
 
 PARAM_REQUEST_LIST sends every parameter once, with its index and the count; PARAM_REQUEST_READ
 answers by index, or by id when the index is -1; PARAM_SET is always answered with the
-parameter's PARAM_VALUE, the new value or, refused, the unchanged one, with a STATUSTEXT
-saying why. A read or set of an id the vehicle does not have gets a STATUSTEXT and no value
-(there is none to give), as a request of an index out of range gets nothing. MAVLink FTP
-gets a NAK at once (:mod:`~vehicle_sim.ftp_server`).
+parameter's PARAM_VALUE, the new value (which the vehicle applies and announces) or, refused,
+the unchanged one, with a STATUSTEXT saying why. A read or set of an id the vehicle does not
+have gets a STATUSTEXT and no value (there is none to give), as a request of an index out of
+range gets nothing. MAVLink FTP gets a NAK at once (:mod:`~vehicle_sim.ftp_server`).
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ class ParamServer:
         table: ParameterTable,
         send: Callable[[Any], None],
         notify: Callable[[int, str], None],
-        on_change: Callable[[str, float], None] = lambda name, value: None,
+        on_change: Callable[[str, float], None],
     ) -> None:
-        """``on_change(name, value)`` applies a value once it is set."""
+        """``on_change(name, value)`` applies and announces a value once it is set."""
         self.table = table
         self._send = send
         self._notify = notify
@@ -63,7 +63,6 @@ class ParamServer:
             value = float(msg.param_value)
             self.table.set(index, value)
             self._on_change(name, value)
-            self._notify(mavlink2.MAV_SEVERITY_INFO, f"{name} set to {value:g}")
         else:
             self._notify(mavlink2.MAV_SEVERITY_WARNING, f"{name} not set: {refusal}")
         self._send(self.table.value_message(index))

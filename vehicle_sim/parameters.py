@@ -1,53 +1,37 @@
 """A vehicle's parameters: the table the MAVLink parameter protocol serves.
 
-Names follow ArduPilot where it has the same setting (``WPNAV_SPEED``, ``FS_GCS_TIMEOUT``,
-``SR0_*``, ``SIM_*``), our own prefix ``SIM_`` where it has none. The table is fixed for a
-run: its order, and so every index, never changes once built. Values go on the wire as
+Its ids, types, ranges and which can change live come from the catalogue
+(:mod:`mission.config.vehicle_parameters`), its values from the scenario. The table is fixed
+for a run: its order, and so every index, never changes once built. Values go on the wire as
 ArduPilot sends them (C-cast: an integer parameter's value converted to the float field;
 AUTOPILOT_VERSION says MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST).
-
-A parameter that would change the run behind the ground station's back is read-only, with the
-reason given to whoever tries to set it.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.config.settings import Scenario
+from mission.config.vehicle_parameters import PARAMETERS, ParameterSpec
 
-ID_LENGTH = 16  # param_id: 16 characters, not terminated when all are used
 REAL32 = mavlink2.MAV_PARAM_TYPE_REAL32
 INT32 = mavlink2.MAV_PARAM_TYPE_INT32
-FIXED_FOR_THE_RUN = "fixed for the run: set it in the scenario"
-INTEGER_TYPES = {
-    mavlink2.MAV_PARAM_TYPE_UINT8,
-    mavlink2.MAV_PARAM_TYPE_INT8,
-    mavlink2.MAV_PARAM_TYPE_UINT16,
-    mavlink2.MAV_PARAM_TYPE_INT16,
-    mavlink2.MAV_PARAM_TYPE_UINT32,
-    INT32,
-}
 
 
 @dataclass(frozen=True)
 class Parameter:
-    """One parameter: its id, MAV_PARAM_TYPE, value, the range a set must fall in, and why it
-    cannot be set (None: it can)."""
+    """One parameter of the table: its catalogue entry, MAV_PARAM_TYPE and value."""
 
-    name: str
+    spec: ParameterSpec
     kind: int
     value: float
-    low: float
-    high: float
-    read_only: str | None = FIXED_FOR_THE_RUN
 
-    def __post_init__(self) -> None:
-        if not 0 < len(self.name) <= ID_LENGTH or not self.name.isascii():
-            raise ValueError(f"parameter id {self.name!r}: 1-{ID_LENGTH} ASCII characters")
+    @property
+    def name(self) -> str:
+        """The parameter's id."""
+        return self.spec.name
 
 
 class ParameterTable:
@@ -84,44 +68,43 @@ class ParameterTable:
         """Why ``value`` (sent as MAV_PARAM_TYPE ``kind``) cannot be set at ``index``; None if
         it can."""
         parameter = self._parameters[index]
-        if parameter.read_only is not None:
-            return parameter.read_only
-        if kind != parameter.kind:
+        if parameter.spec.read_only is None and kind != parameter.kind:
             return f"is of type {parameter.kind}, not {kind}"
-        if not math.isfinite(value):
-            return "needs a finite value"
-        if parameter.kind in INTEGER_TYPES and value != round(value):
-            return "needs a whole number"
-        if not parameter.low <= value <= parameter.high:
-            return f"must be in [{parameter.low:g}, {parameter.high:g}]"
-        return None
+        return parameter.spec.refusal(value)
 
     def set(self, index: int, value: float) -> None:
         """Set a value :meth:`refusal` accepted."""
         old = self._parameters[index]
-        self._parameters[index] = Parameter(old.name, old.kind, value, old.low, old.high, None)
+        self._parameters[index] = Parameter(old.spec, old.kind, value)
 
 
 def vehicle_parameters(scenario: Scenario, speed_m_s: float, speedup: float) -> ParameterTable:
     """The table of a vehicle of ``scenario`` flying at most ``speed_m_s`` at ``speedup``
-    (1 in lockstep): its own settings and the simulation's."""
+    (1 in lockstep): every parameter of the catalogue, sorted by id, valued from the scenario."""
     v = scenario.vehicle
-    step_s = scenario.control.t_cont_s
+    values = {
+        "FS_GCS_TIMEOUT": v.failsafe_s,
+        "WPNAV_SPEED": 100 * speed_m_s,  # cm/s, as ArduPilot keeps it
+        "SR0_EXTRA1": round(v.sensor_hz),
+        "SR0_EXT_STAT": round(v.status_hz),
+        "SIM_RATE_HZ": round(1 / scenario.control.t_cont_s),
+        "SIM_SPEEDUP": speedup,
+        "SIM_GPS1_ENABLE": 1,
+        "SIM_GPS1_HZ": round(v.sensor_hz),
+        "SIM_GPS1_LAG_MS": 0,
+        "SIM_GPS1_GLTCH_X": 0.0,
+        "SIM_GPS1_GLTCH_Y": 0.0,
+        "SIM_GPS1_GLTCH_Z": 0.0,
+        "SIM_GPS_UERE": scenario.gnss.sigma_uere_m,
+        "SIM_MP_SCALE": 1.0,
+        "SIM_CAM_RANGE": scenario.camera.range_m,
+        "SIM_CAM_NOISE": 1.0,
+        "SIM_TRACK_NOISE": v.tracking_noise_m,
+        "SIM_RADIUS": v.radius_m,
+        "SIM_FAIL_ENABLE": 0,
+    }
     rows = [
-        # the vehicle's own, under ArduPilot's names (cm/s, as ArduPilot keeps them)
-        Parameter("WPNAV_SPEED", REAL32, 100 * speed_m_s, 0, 5000),
-        Parameter("FS_GCS_TIMEOUT", REAL32, v.failsafe_s, 0.1, 120, None),  # live
-        Parameter("SR0_EXTRA1", INT32, round(v.sensor_hz), 0, 1000),
-        Parameter("SR0_EXT_STAT", INT32, round(v.status_hz), 0, 1000),
-        Parameter("SIM_RATE_HZ", INT32, round(1 / step_s), 1, 10000),
-        # the simulation's
-        Parameter("SIM_SPEEDUP", REAL32, speedup, 0.1, 1000, "the run's clock: --speedup"),
-        Parameter("SIM_GPS1_ENABLE", INT32, 1, 0, 1, None),  # live: 0 is a GNSS failed off
-        Parameter("SIM_GPS1_HZ", INT32, round(v.sensor_hz), 1, 100),
-        Parameter("SIM_GPS_UERE", REAL32, scenario.gnss.sigma_uere_m, 0, 100),
-        Parameter("SIM_CAM_RANGE", REAL32, scenario.camera.range_m, 0, 1000),
-        Parameter("SIM_RADIUS", REAL32, v.radius_m, 0, 10),
-        Parameter("SIM_FAIL_ENABLE", INT32, 0, 0, 1, None),  # MAV_CMD_INJECT_FAILURE allowed
-        Parameter("SIM_TRACK_NOISE", REAL32, v.tracking_noise_m, 0, 10),
+        Parameter(spec, INT32 if spec.integer else REAL32, float(values[spec.name]))
+        for spec in PARAMETERS
     ]
     return ParameterTable(sorted(rows, key=lambda p: p.name))

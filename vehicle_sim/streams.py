@@ -25,12 +25,7 @@ def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -
             k.believed, k.velocity, np.zeros(3), vehicle.frame, vehicle.time_boot_ms
         )
     if message_id == mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT:
-        offset = vehicle.world.zone_offset(k.truth[None])[0]
-        fix = vehicle.world.gnss.sample_fix(k.truth, vehicle.rng_gnss, offset)
-        healthy = telemetry.gps_raw_int(
-            fix, vehicle.frame, vehicle.time_unix_usec, vehicle.scenario.gnss.sigma_uere_m
-        )
-        return vehicle.failures.filter(message_id, healthy)
+        return vehicle.gnss.reading(k.truth, vehicle.time_unix_usec)
     if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
         observed = vehicle.observe(work_truth)
         healthy = telemetry.landing_target(observed, vehicle.time_unix_usec, 1)

@@ -9,23 +9,25 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.config.settings import Scenario
 from mission.link.mavlink_udp import LinkCounters
-from mission.link.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
+from mission.link.vehicle_events import event_text, parameter_change
 from mission.link.vehicle_identity import VehicleIdentity
-from mission.world.frames import GeodeticFrame, ned_to_enu
+from mission.world.frames import GeodeticFrame
 from mission.world.model import World
 from mission.world.proximity import StructureProximity
 from vehicle_sim import failures, modes, streams, telemetry
-from vehicle_sim.commands import execute, set_mode
+from vehicle_sim.auto_mission import fly_mission
 from vehicle_sim.contact import Contact, ContactDetector, ContactWatch, as_sent
 from vehicle_sim.failures import SensorFailures
-from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
+from vehicle_sim.fault_schedule import FaultSchedule
+from vehicle_sim.gnss_receiver import GnssReceiver
+from vehicle_sim.incoming import HANDLERS
 from vehicle_sim.kinematics import Kinematics
 from vehicle_sim.mission_server import MissionServer
 from vehicle_sim.param_server import ParamServer
@@ -82,9 +84,8 @@ class Vehicle:
         self.steps = 0
         self.counters = LinkCounters()
         self.failsafe = False
-        self._last_setpoint_s = 0.0
-        self._last_warning = ""
-        self._last_warning_s = -math.inf
+        self.last_setpoint_s = 0.0
+        self.last_warning = ("", -math.inf)  # the last warning said, and when
         vs = scenario.vehicle
         self.step_s = scenario.control.t_cont_s
         self.speed_limit_m_s = (
@@ -104,6 +105,9 @@ class Vehicle:
         self._last_sent_s: dict[int, float] = {}
         self.failures = SensorFailures(failure_seed, vs.sensor_hz)
         self.mission, self.params = self._protocol_servers(speedup)
+        self.gnss = GnssReceiver(world, self.frame, self.rng_gnss, self.params.table, self.failures)
+        self.faults = FaultSchedule(scenario.faults, identity.name)
+        self._before_fault: dict[int, float] = {}  # a parameter's value before its fault
 
     def _protocol_servers(self, speedup: float) -> tuple[MissionServer, ParamServer]:
         """The mission protocol's server and the parameter protocol's."""
@@ -119,11 +123,44 @@ class Vehicle:
         table = vehicle_parameters(self.scenario, self.speed_limit_m_s, speedup)
         return mission, ParamServer(table, self.send, self.notify, self._parameter_set)
 
-    def _parameter_set(self, name: str, value: float) -> None:
-        """A parameter set live takes effect (before the next step)."""
+    def _parameter_set(self, name: str, value: float, source: str = "Set") -> None:
+        """A parameter set live takes effect before the next step, and is said. Most are read
+        where they are used (the GNSS receiver, the camera, the failsafe, the motion)."""
         if name == "SIM_GPS1_ENABLE":  # as ArduPilot's: 0 turns the receiver off
-            kind = failures.OK if value else failures.OFF
-            self.failures.inject(failures.GPS, kind)
+            self.failures.inject(failures.GPS, failures.OK if value else failures.OFF)
+        elif name == "SIM_GPS1_HZ":
+            self.intervals_s[mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT] = 1.0 / value
+        elif name == "WPNAV_SPEED":
+            self.speed_limit_m_s = value / 100.0
+        what = parameter_change(name, value)
+        self.notify(mavlink2.MAV_SEVERITY_INFO, event_text(source, what, self.sim_time_s))
+
+    def inject_failure(self, unit: int, kind: int, source: str = "Failure") -> bool:
+        """Fail ``unit`` as ``kind`` (OK: healthy again) and say so; False if not offered."""
+        if not self.failures.inject(unit, kind):
+            return False
+        what = failures.failure_name(unit, kind)
+        self.notify(mavlink2.MAV_SEVERITY_WARNING, event_text(source, what, self.sim_time_s))
+        return True
+
+    def _apply_faults(self) -> None:
+        """The scenario's faults due at this step boundary (:mod:`vehicle_sim.fault_schedule`)."""
+        for change in self.faults.due(self.sim_time_s):
+            fault = change.fault
+            if fault.failure is not None:
+                unit, kind = failures.parse_failure(fault.failure)
+                self.inject_failure(unit, failures.OK if change.ends else kind, "Fault")
+                continue
+            table = self.params.table
+            index = table.index_of(str(fault.param))
+            assert index is not None  # the scenario's check: a catalogue id
+            if change.ends:
+                value = self._before_fault.pop(index)
+            else:
+                self._before_fault[index] = table[index].value
+                value = float(fault.value)  # type: ignore[arg-type]
+            table.set(index, value)
+            self._parameter_set(table[index].name, value, "Fault")
 
     # -- outgoing ---------------------------------------------------------------------------
     def notify(self, severity: int, text: str) -> None:
@@ -181,7 +218,14 @@ class Vehicle:
 
         if work_truth is None or self.identity.is_work:
             return Observation(False, None, math.nan)
-        return self.world.camera.observe(self.kinematics.truth, work_truth, self.rng_camera)
+        value = self.params.table.value
+        return self.world.camera.observe(
+            self.kinematics.truth,
+            work_truth,
+            self.rng_camera,
+            range_m=value("SIM_CAM_RANGE"),
+            noise_scale=value("SIM_CAM_NOISE"),
+        )
 
     # -- stepping ---------------------------------------------------------------------------
     def step(self, others: dict[str, tuple[np.ndarray, np.ndarray]] | None = None) -> None:
@@ -197,14 +241,14 @@ class Vehicle:
             self._report(self.watch.new_contacts("vehicles", found))
         self._check_failsafe()
         if self.armed and self.mode == modes.AUTO:
-            self._fly_mission()
+            fly_mission(self)
         start, start_s = self.kinematics.truth.copy(), self.sim_time_s
         if self.armed:
             self.kinematics.step(
                 self.step_s,
                 self.speed_limit_m_s,
                 self.rng_motion,
-                self.scenario.vehicle.tracking_noise_m,
+                self.params.table.value("SIM_TRACK_NOISE"),
             )
         self.steps += 1
         self.sim_time_s = self.steps * self.step_s
@@ -214,6 +258,8 @@ class Vehicle:
             )
             self._report(self.watch.new_contacts("surroundings", found))
         self._last_move = (as_sent(start), as_sent(self.kinematics.truth))
+        if len(self.faults):
+            self._apply_faults()
 
     def _report(self, contacts: list[Contact]) -> None:
         """Say what was touched; a crash stops the vehicle where it touched and disarms it."""
@@ -230,53 +276,18 @@ class Vehicle:
         """Take up a running clock before the first step: the next step ends at ``time_s``."""
         self.steps = max(0, round(time_s / self.step_s) - 1)
         self.sim_time_s = self.steps * self.step_s
-        self._last_setpoint_s = self.sim_time_s
+        self.last_setpoint_s = self.sim_time_s
 
     def _check_failsafe(self) -> None:
         if not (self.armed and self.mode == modes.GUIDED) or self.failsafe:
             return
         limit = self.params.table.value("FS_GCS_TIMEOUT")  # the scenario's, unless set
-        if self.sim_time_s - self._last_setpoint_s >= limit - 1e-9:
+        if self.sim_time_s - self.last_setpoint_s >= limit - 1e-9:
             self.failsafe = True
             self.kinematics.hold()
             self.notify(
                 mavlink2.MAV_SEVERITY_CRITICAL, f"Failsafe: no setpoint for {limit:g} s, holding"
             )
-
-    def _fly_mission(self) -> None:
-        items = self.mission.items
-        current = self.mission.current
-        if not items:
-            return
-        if current == 0 and len(items) > 1:
-            self.mission.set_current(1)
-            current = 1
-        item = items[current]
-        if item.command not in NAV_POSITION_COMMANDS or item.frame not in GLOBAL_FRAMES:
-            if current + 1 < len(items):
-                self.mission.set_current(current + 1)
-            return
-        target = self.item_position(item)
-        self.kinematics.target = target
-        acceptance = item.param2 if item.param2 > 0 else self.scenario.control.arrival_tol_m
-        if np.linalg.norm(target - self.kinematics.believed) < acceptance:
-            if current + 1 < len(items):
-                self.mission.set_current(current + 1)
-            else:
-                self.send(mavlink2.MAVLink_mission_item_reached_message(current))
-                self.mode = modes.LOITER
-                self.kinematics.hold()
-                self.notify(mavlink2.MAV_SEVERITY_INFO, "Mission complete, holding")
-
-    def item_position(self, item) -> np.ndarray:
-        """ENU position of a global mission item (relative altitudes from the anchor)."""
-        alt = item.z
-        if item.frame in (
-            mavlink2.MAV_FRAME_GLOBAL_RELATIVE_ALT,
-            mavlink2.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-        ):
-            alt += self.scenario.world.anchor.alt_m
-        return self.frame.from_degE7(item.x, item.y, alt)
 
     # -- incoming ---------------------------------------------------------------------------
     def handle(self, msg: Any, wall_now: float) -> None:
@@ -287,90 +298,16 @@ class Vehicle:
             return
         if self.mission.handle(msg, wall_now) or self.params.handle(msg):
             return
-        handler = self._HANDLERS.get(msg.get_type())
+        handler = HANDLERS.get(msg.get_type())
         if handler is not None:
             handler(self, msg)
-
-    def _on_setpoint(self, msg: Any) -> None:
-        if self.crashed:
-            self.counters.reject("setpoint: crashed")
-            return
-        problem = setpoint_problem(msg, self.armed and self.mode == modes.GUIDED)
-        target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
-        if problem is None:
-            problem = geofence_problem(self.world, self.kinematics.believed, target)
-            if problem is not None:  # a guided vehicle told to leave the fence stops there
-                self.kinematics.hold()
-        if problem is not None:
-            category, detail = problem
-            self.counters.reject(f"setpoint: {category}")
-            self._warn_once(f"Setpoint rejected: {detail}")
-            return
-        self.kinematics.target = target
-        self._last_setpoint_s = self.sim_time_s
-        if self.failsafe:
-            self.failsafe = False
-            self.notify(mavlink2.MAV_SEVERITY_NOTICE, "Failsafe cleared: setpoints resumed")
-
-    def _warn_once(self, text: str) -> None:
-        """A warning STATUSTEXT, not repeated while the same problem persists (5 s)."""
-        if text != self._last_warning or self.sim_time_s - self._last_warning_s >= 5.0:
-            self.notify(mavlink2.MAV_SEVERITY_WARNING, text)
-            self._last_warning, self._last_warning_s = text, self.sim_time_s
-
-    def _on_vision_estimate(self, msg: Any) -> None:
-        values = (msg.x, msg.y, msg.z)
-        if not all(math.isfinite(v) and abs(v) < MAX_ABS_COORD_M for v in values):
-            self.counters.reject("estimate out of range")
-            return
-        self.kinematics.set_estimate(ned_to_enu(np.array(values, dtype=float)))
-
-    def _on_command(self, msg: Any) -> None:
-        params = [msg.param1, msg.param2, msg.param3, msg.param4]
-        if msg.get_type() == "COMMAND_LONG":
-            params += [msg.param5, msg.param6, msg.param7]
-        else:
-            params += [msg.x, msg.y, msg.z]
-        result = execute(self, int(msg.command), params)
-        self.send(
-            mavlink2.MAVLink_command_ack_message(
-                msg.command, result, 0, 0, msg.get_srcSystem(), msg.get_srcComponent()
-            )
-        )
-
-    def _on_set_mode(self, msg: Any) -> None:
-        result = set_mode(self, int(msg.base_mode), int(msg.custom_mode))
-        self.send(
-            mavlink2.MAVLink_command_ack_message(
-                mavlink2.MAVLINK_MSG_ID_SET_MODE,
-                result,
-                0,
-                0,
-                msg.get_srcSystem(),
-                msg.get_srcComponent(),
-            )
-        )
-
-    def _on_timesync(self, msg: Any) -> None:
-        if msg.tc1 == 0:
-            now_ns = round(self.sim_time_s * 1e9)
-            self.send(mavlink2.MAVLink_timesync_message(now_ns, msg.ts1))
-
-    _HANDLERS: ClassVar[dict[str, Callable[[Vehicle, Any], None]]] = {
-        "SET_POSITION_TARGET_LOCAL_NED": _on_setpoint,
-        "VISION_POSITION_ESTIMATE": _on_vision_estimate,
-        "COMMAND_LONG": _on_command,
-        "COMMAND_INT": _on_command,
-        "SET_MODE": _on_set_mode,
-        "TIMESYNC": _on_timesync,
-    }
 
     # -- used by commands -------------------------------------------------------------------
     def arm(self, armed: bool) -> None:
         """Arm (hold here until told otherwise) or disarm."""
         if armed and not self.armed:
             self.kinematics.hold()
-            self._last_setpoint_s = self.sim_time_s
+            self.last_setpoint_s = self.sim_time_s
         self.armed = armed
         self.failsafe = False
         self.notify(mavlink2.MAV_SEVERITY_INFO, "Armed" if armed else "Disarmed")
@@ -381,7 +318,7 @@ class Vehicle:
             self.mode = mode
             if mode in (modes.LOITER, modes.GUIDED):
                 self.kinematics.hold()
-            self._last_setpoint_s = self.sim_time_s
+            self.last_setpoint_s = self.sim_time_s
             self.failsafe = False
             self.notify(mavlink2.MAV_SEVERITY_INFO, f"Mode {modes.NAMES[mode]}")
 

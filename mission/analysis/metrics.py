@@ -29,6 +29,8 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.analysis.safety import safety_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate, truth_time
 from mission.config.settings import Scenario
+from mission.link.vehicle_events import parse_event
+from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
 
@@ -58,6 +60,7 @@ class RunTrace:
     completion: float | None = None
     link_events: list[dict[str, Any]] = field(default_factory=list)
     contacts: list[dict[str, Any]] = field(default_factory=list)  # as the vehicles reported them
+    events: list[dict[str, Any]] = field(default_factory=list)  # faults, sets, failures
     stopped: str | None = None  # the ground station's word that it stopped the run
     max_gap_s: float = 1.0  # truth is interpolated between samples at most this far apart
 
@@ -129,6 +132,9 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             contact = _CONTACT.match(message.text)
             if contact:
                 trace.contacts.append(_contact_event(source, contact))
+            event = parse_event(message.text, VehicleIdentity.from_system_id(source).name)
+            if event is not None:
+                trace.events.append(event)
         elif kind == "TIMESYNC" and source != GCS_SYSTEM_ID:
             received_ns = round(message._timestamp * 1e9 - epoch * 1e9)
             replies.append(TimesyncReply(source, message.tc1, message.ts1, received_ns))
@@ -269,6 +275,7 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": _stats([float(e) for e in errors]),
         "link_events": trace.link_events,
+        "events": trace.events,
         "safety": safety_metrics(trace, world),
     }
 

@@ -15,6 +15,7 @@ from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
 from mission.config.errors import FieldProblem
+from mission.config.fault_settings import Fault, check_faults
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
 
@@ -336,9 +337,11 @@ class Scenario:
     planner: PlannerSettings
     vehicle: VehicleSettings
     limits: LimitSettings
+    faults: list[Fault]
 
     def __post_init__(self) -> None:
         self._check_margins()
+        check_faults(self.faults, self.task.supports, self.run.timeout_s)
         for i, point in enumerate(self.task.work_waypoints_m):
             box = self.world.workspace
             inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))

@@ -93,18 +93,25 @@ class CameraModel:
         return in_range & clear
 
     def observe(
-        self, observer: np.ndarray, target: np.ndarray, rng: np.random.Generator
+        self,
+        observer: np.ndarray,
+        target: np.ndarray,
+        rng: np.random.Generator,
+        range_m: float | None = None,
+        noise_scale: float = 1.0,
     ) -> Observation:
-        """One observation of ``target`` from ``observer`` (true positions).
+        """One observation of ``target`` from ``observer`` (true positions); ``range_m`` and
+        ``noise_scale`` (times every sigma) where the camera is not as the settings say.
 
         The single-vector path of :meth:`observable` and :meth:`sample`, in scalar arithmetic
         because the vehicles call it every step.
         """
+        reach = self.settings.range_m if range_m is None else range_m
         observer = np.asarray(observer, dtype=float).reshape(3)
         target = np.asarray(target, dtype=float).reshape(3)
         z = target - observer
         d = math.sqrt(float(z @ z))
-        if not 0 < d <= self.settings.range_m:
+        if not 0 < d <= reach:
             return Observation(False, None, d)
         if self.structure is not None and self.structure.segments_blocked(observer, target)[0]:
             return Observation(False, None, d)
@@ -119,4 +126,6 @@ class CameraModel:
             ]
         )
         sigma = np.array([float(self.sigma_d(d)), self._sigma_phi, self._sigma_theta])
+        if noise_scale != 1.0:
+            sigma = noise_scale * sigma
         return Observation(True, z + jacobian @ (sigma * rng.standard_normal(3)), d)

@@ -146,17 +146,23 @@ class GnssModel:
         return self.settings.sigma_uere_m * self.geometry(points).pdop
 
     def sample_fix(
-        self, point: np.ndarray, rng: np.random.Generator, offset_m: np.ndarray | None = None
+        self,
+        point: np.ndarray,
+        rng: np.random.Generator,
+        offset_m: np.ndarray | None = None,
+        sigma_uere_m: float | None = None,
     ) -> GnssFix:
-        """One fix at true position ``point``: truth + N(0, Sigma_GNSS) + multipath offset."""
+        """One fix at true position ``point``: truth + N(0, Sigma_GNSS) + multipath offset
+        (``sigma_uere_m``: the receiver's, where it is not the settings')."""
         point = np.asarray(point, dtype=float).reshape(3)
         visible = self.visibility(point[None])[0]
         n_visible = int(visible.sum())
         cov_geom, factor = self._fix_geometry(visible)
         if cov_geom is None or factor is None:
             return GnssFix(False, None, None, n_visible, None, None)
-        covariance = self.settings.sigma_uere_m**2 * cov_geom
-        noise = self.settings.sigma_uere_m * (factor @ rng.standard_normal(3))
+        sigma = self.settings.sigma_uere_m if sigma_uere_m is None else sigma_uere_m
+        covariance = sigma**2 * cov_geom
+        noise = sigma * (factor @ rng.standard_normal(3))
         offset = np.zeros(3) if offset_m is None else np.asarray(offset_m, dtype=float)
         hdop = float(np.sqrt(cov_geom[0, 0] + cov_geom[1, 1]))
         return GnssFix(
