@@ -9,7 +9,7 @@ truth) is logged, never read.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -19,6 +19,7 @@ from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import KnownWorld
 
 MIN_3D_FIX = 3
+IMPLAUSIBLE_FIX_M = 100.0  # a fix this far outside the workspace is a failed receiver's
 
 
 def gnss_fix(message: Any | None, frame: GeodeticFrame) -> np.ndarray | None:
@@ -86,14 +87,26 @@ def reports_from_messages(samples: Sequence[Sample], frame: GeodeticFrame) -> li
     return reports
 
 
+def plausible_fix(fix: np.ndarray | None, world: KnownWorld) -> bool:
+    """False for a fix more than :data:`IMPLAUSIBLE_FIX_M` outside the workspace."""
+    if fix is None:
+        return True
+    low = np.array(world.workspace.min_m) - IMPLAUSIBLE_FIX_M
+    high = np.array(world.workspace.max_m) + IMPLAUSIBLE_FIX_M
+    return bool(np.all((fix >= low) & (fix <= high)))
+
+
 def localize(values: Sequence[SupportReport], world: KnownWorld) -> list[SupportMeasurement]:
     """p_n and r_n with covariances evaluated at the measured values (MODEL.md 3.2.1): the GNSS
     geometry of every fix in one batch and the camera's Sigma_r of every observation in
     another (the same numbers as one at a time, tested).
 
     Where the model sees no fix at p_n but the receiver has one, the receiver's reported
-    accuracy stands in for Sigma_GNSS.
+    accuracy stands in for Sigma_GNSS. A fix more than :data:`IMPLAUSIBLE_FIX_M` outside the
+    workspace is no fix (a receiver sending garbage): that support is then handled as one
+    without GNSS.
     """
+    values = [v if plausible_fix(v.fix, world) else replace(v, fix=None) for v in values]
     with_fix = [v for v in values if v.fix is not None]
     sigma_of: dict[str, np.ndarray | None] = {}
     if with_fix:

@@ -275,7 +275,7 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": _stats([float(e) for e in errors]),
         "link_events": trace.link_events,
-        "events": trace.events,
+        "events": sorted(trace.events, key=lambda e: (e["t"], e["vehicle"])),
         "safety": safety_metrics(trace, world),
     }
 

@@ -20,6 +20,13 @@ from tests.bad_input.builders import (
     wpl_rows,
 )
 
+FAULT = "faults: [{{at_s: 10, {}}}]\n"
+OVERLAP = (
+    "faults:\n"
+    "  - {at_s: 10, vehicle: support-2, failure: gps off, duration_s: 30}\n"
+    "  - {at_s: 20, vehicle: support-2, param: SIM_GPS1_ENABLE, value: 0}\n"
+)
+
 FILE_CASES = [
     # --- safety margins ----------------------------------------------------------------
     (
@@ -51,6 +58,60 @@ FILE_CASES = [
         "run-plan-breaks-clearance",
         lambda t: [*RUN, str(scenario_file(t, "control: {clearance_m: 1.5}\n"))],
         ["work.waypoints", "item", "control.clearance_m (1.5 m)"],
+    ),
+    # --- scripted faults ---------------------------------------------------------------
+    (
+        "faults-unknown-vehicle",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, FAULT.format("vehicle: support-7, failure: gps off"))),
+        ],
+        ["bad.yaml", "faults[0].vehicle", "no support-7"],
+    ),
+    (
+        "faults-unknown-parameter",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, FAULT.format("vehicle: support-1, param: SIM_X, value: 1"))),
+        ],
+        ["bad.yaml", "faults[0].param", "no parameter 'SIM_X'"],
+    ),
+    (
+        "faults-read-only-parameter",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, FAULT.format("vehicle: work, param: SIM_RADIUS, value: 1"))),
+        ],
+        ["bad.yaml", "faults[0].param", "SIM_RADIUS cannot change during a run"],
+    ),
+    (
+        "faults-value-out-of-range",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, FAULT.format("vehicle: work, param: SIM_MP_SCALE, value: -1"))),
+        ],
+        ["bad.yaml", "faults[0].value", "must be in [0, 10]"],
+    ),
+    (
+        "faults-unknown-failure",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, FAULT.format("vehicle: support-1, failure: camera garbage"))),
+        ],
+        ["bad.yaml", "faults[0].failure", "a camera failure is one of"],
+    ),
+    (
+        "faults-past-the-run",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, "faults: [{at_s: 5000, vehicle: work, failure: gps off}]\n")),
+        ],
+        ["bad.yaml", "faults[0].at_s", "past the run's end"],
+    ),
+    (
+        "faults-overlap",
+        lambda t: [*RUN, str(scenario_file(t, OVERLAP))],
+        ["bad.yaml", "faults[1]", "overlaps faults[0] on support-2's gps"],
     ),
     # --- scenario YAML -----------------------------------------------------------------
     (
