@@ -62,8 +62,24 @@ class Point:
 
     @property
     def label(self) -> str:
-        """``key=value, ...`` (``defaults`` for none)."""
-        return ", ".join(f"{k}={v}" for k, v in self.overrides) or "defaults"
+        """``key=value, ...`` (``defaults`` for none; ``faults`` told briefly)."""
+        return ", ".join(f"{k}={_value_text(k, v)}" for k, v in self.overrides) or "defaults"
+
+
+def _value_text(key: str, value: Any) -> str:
+    """A point's value as its label shows it: a scenario's ``faults:`` entries as
+    ``support-1 gps off 10-40 s``, anything else as Python prints it."""
+    if key != "faults" or not isinstance(value, list):
+        return str(value)
+    told = []
+    for fault in value:
+        if not isinstance(fault, dict):
+            return str(value)
+        what = fault.get("failure") or f"{fault.get('param')}={fault.get('value')}"
+        start, duration = fault.get("at_s"), fault.get("duration_s")
+        when = f"from {start} s" if duration is None else f"{start}-{start + duration:g} s"
+        told.append(f"{fault.get('vehicle')} {what} {when}")
+    return "; ".join(told) or "none"
 
 
 @dataclass(frozen=True)
