@@ -142,7 +142,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     channels = _open_channels(args, identity, port, key, link, scenario.task.supports)
     server = VehicleServer(channels.endpoint, outs, clock, *channels.truth, args.exit_with_parent)
     vehicle = Vehicle(
-        identity, scenario, world, home, args.seed, server.broadcast, speedup=clock.speedup
+        identity,
+        scenario,
+        world,
+        home,
+        args.seed,
+        server.broadcast,
+        speedup=clock.speedup,
+        link_loss=link.loss,
     )
     server.attach(vehicle)
     install_signal_handlers(server.stop, args.exit_with_parent)

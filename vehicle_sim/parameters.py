@@ -78,9 +78,12 @@ class ParameterTable:
         self._parameters[index] = Parameter(old.spec, old.kind, value)
 
 
-def vehicle_parameters(scenario: Scenario, speed_m_s: float, speedup: float) -> ParameterTable:
+def vehicle_parameters(
+    scenario: Scenario, speed_m_s: float, speedup: float, link_loss: float = 0.0
+) -> ParameterTable:
     """The table of a vehicle of ``scenario`` flying at most ``speed_m_s`` at ``speedup``
-    (1 in lockstep): every parameter of the catalogue, sorted by id, valued from the scenario."""
+    (1 in lockstep) and losing ``link_loss`` of what it sends: every parameter of the
+    catalogue, sorted by id, valued from the scenario and the command line."""
     v = scenario.vehicle
     values = {
         "FS_GCS_TIMEOUT": v.failsafe_s,
@@ -100,6 +103,7 @@ def vehicle_parameters(scenario: Scenario, speed_m_s: float, speedup: float) -> 
         "SIM_CAM_RANGE": scenario.camera.range_m,
         "SIM_CAM_NOISE": 1.0,
         "SIM_TRACK_NOISE": v.tracking_noise_m,
+        "SIM_LINK_LOSS": link_loss,
         "SIM_RADIUS": v.radius_m,
         "SIM_FAIL_ENABLE": 0,
     }

@@ -60,6 +60,7 @@ class Vehicle:
         seed: int,
         send: Callable[[Any], None],
         speedup: float = 1.0,
+        link_loss: float = 0.0,
     ) -> None:
         self.identity = identity
         self.scenario = scenario
@@ -104,12 +105,15 @@ class Vehicle:
         self._default_intervals = dict(self.intervals_s)
         self._last_sent_s: dict[int, float] = {}
         self.failures = SensorFailures(failure_seed, vs.sensor_hz)
-        self.mission, self.params = self._protocol_servers(speedup)
+        self.on_link_loss: Callable[[float], None] | None = None  # the server's, when attached
+        self.mission, self.params = self._protocol_servers(speedup, link_loss)
         self.gnss = GnssReceiver(world, self.frame, self.rng_gnss, self.params.table, self.failures)
         self.faults = FaultSchedule(scenario.faults, identity.name)
         self._before_fault: dict[int, float] = {}  # a parameter's value before its fault
 
-    def _protocol_servers(self, speedup: float) -> tuple[MissionServer, ParamServer]:
+    def _protocol_servers(
+        self, speedup: float, link_loss: float
+    ) -> tuple[MissionServer, ParamServer]:
         """The mission protocol's server and the parameter protocol's."""
         vs = self.scenario.vehicle
         mission = MissionServer(
@@ -120,7 +124,7 @@ class Vehicle:
             retries=vs.mission_retries,
             capacity=vs.mission_capacity,
         )
-        table = vehicle_parameters(self.scenario, self.speed_limit_m_s, speedup)
+        table = vehicle_parameters(self.scenario, self.speed_limit_m_s, speedup, link_loss)
         return mission, ParamServer(table, self.send, self.notify, self._parameter_set)
 
     def _parameter_set(self, name: str, value: float, source: str = "Set") -> None:
@@ -132,6 +136,8 @@ class Vehicle:
             self.intervals_s[mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT] = 1.0 / value
         elif name == "WPNAV_SPEED":
             self.speed_limit_m_s = value / 100.0
+        elif name == "SIM_LINK_LOSS" and self.on_link_loss is not None:
+            self.on_link_loss(value)
         what = parameter_change(name, value)
         self.notify(mavlink2.MAV_SEVERITY_INFO, event_text(source, what, self.sim_time_s))
 

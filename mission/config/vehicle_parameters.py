@@ -77,6 +77,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     _live("SIM_CAM_RANGE", False, 0, 1000, "the camera's range, m (camera.range_m)"),
     _live("SIM_CAM_NOISE", False, 0, 100, "scale of the camera's noise (1: camera.sigma_*)"),
     _live("SIM_TRACK_NOISE", False, 0, 10, "tracking noise per step, m (vehicle.tracking_noise_m)"),
+    _live("SIM_LINK_LOSS", False, 0, 0.9, "chance a datagram sent is lost (--link-loss)"),
     _fixed("SIM_RADIUS", False, "the body's radius for contact, m (vehicle.radius_m)"),
     _live("SIM_FAIL_ENABLE", True, 0, 1, "1 allows MAV_CMD_INJECT_FAILURE (PX4's SYS_FAILURE_EN)"),
 )

@@ -8,7 +8,7 @@ import socket
 import time
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
@@ -124,6 +124,16 @@ class UdpEndpoint:
         self.link = (
             ImpairedLink(self.sock, link, link_seed) if link is not None and link.impaired else None
         )
+        self._link_seed = link_seed
+
+    def set_loss(self, loss: float) -> None:
+        """Lose each datagram sent from now on with probability ``loss`` (the delay as it is);
+        the drops come from the link's seeded generator, made on first use."""
+        if self.link is None:
+            if loss > 0:
+                self.link = ImpairedLink(self.sock, LinkSettings(loss=loss), self._link_seed)
+            return
+        self.link.settings = replace(self.link.settings, loss=loss)
 
     def _transmit(self, datagram: bytes, destination: Address) -> bool:
         """One datagram out, through the impaired link if there is one."""

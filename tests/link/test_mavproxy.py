@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from ground_station.links.mission_client import MissionClient, MissionTransferError
 from mission.link.waypoints import (
@@ -90,10 +91,17 @@ def test_mavproxy_loads_and_lists_a_waypoint_file(along, tmp_path):
         assert float(fields[4]) == row.z
 
 
+def _read(reader: MavClient, name: str) -> float | None:
+    """A parameter's value read by id (None: no answer)."""
+    reader.send(mavlink2.MAVLink_param_request_read_message(2, 1, name.encode(), -1))
+    echo = reader.wait_for("PARAM_VALUE", timeout_s=0.5, where=lambda m: m.param_id == name)
+    return None if echo is None else echo.param_value
+
+
 def test_mavproxy_fetches_and_shows_the_parameters_after_its_ftp_attempt(tmp_path):
     """MAVProxy with its ftp module asks for ``@PARAM/param.pck`` first; the vehicle's NAK
-    sends it to the parameter protocol at once, and ``param show`` lists the vehicle's
-    parameters with their values."""
+    sends it to the parameter protocol at once, ``param show`` lists the vehicle's parameters
+    with their values, and ``param set`` changes a live one and not a read-only one."""
     with vehicle_process("support-1", "--speedup", "1") as vehicle:
         shower, lines = _mavproxy(
             vehicle.port, "param fetch", tmp_path, modules="param,ftp", commands_later=True
@@ -103,10 +111,19 @@ def test_mavproxy_fetches_and_shows_the_parameters_after_its_ftp_attempt(tmp_pat
             time.sleep(0.2)
         assert shower.stdin is not None
         shower.stdin.write("param show SIM_*\nparam show WPNAV_SPEED\n")
+        shower.stdin.write("param set SIM_GPS_UERE 0.5\nparam set SIM_SPEEDUP 3\n")
         shower.stdin.flush()
         while time.monotonic() < deadline and not any("WPNAV_SPEED" in x for x in lines):
             time.sleep(0.2)
+        reader = MavClient(vehicle.address)
+        try:  # a second ground station sees what MAVProxy's sets did
+            while time.monotonic() < deadline and _read(reader, "SIM_GPS_UERE") != 0.5:
+                time.sleep(0.2)
+            values = {name: _read(reader, name) for name in ("SIM_GPS_UERE", "SIM_SPEEDUP")}
+        finally:
+            reader.close()
         stop_process(shower)
+    assert values == {"SIM_GPS_UERE": 0.5, "SIM_SPEEDUP": 1.0}, (values, lines)  # 3: refused
     assert any("parameter list (ftp)" in x for x in lines), "MAVProxy tried FTP first"
     shown = {x.split()[0]: x.split()[1] for x in lines if x.startswith(("SIM_", "WPNAV_"))}
     assert float(shown["WPNAV_SPEED"]) == 100.0 and float(shown["SIM_SPEEDUP"]) == 1.0, lines

@@ -4,6 +4,7 @@ mission uploads, and counts what it refused; key files are checked."""
 from __future__ import annotations
 
 import re
+import time
 
 import numpy as np
 import pytest
@@ -53,6 +54,14 @@ def test_a_signed_vehicle_obeys_only_signed_traffic(key_file, along, client_key,
         client.setpoint(2, HOME + np.array([3.0, 0.0, 0.0]))
         client.send(mavlink2.MAVLink_system_time_message(0, 0))  # a clock tick (a no-op)
         messages = clock.step_to(500)
+        client.send(
+            mavlink2.MAVLink_param_set_message(
+                2, 1, b"FS_GCS_TIMEOUT", 7.0, mavlink2.MAV_PARAM_TYPE_REAL32
+            )
+        )
+        time.sleep(0.2)
+        clock.send(mavlink2.MAVLink_param_request_read_message(2, 1, b"FS_GCS_TIMEOUT", -1))
+        timeout = clock.wait_for("PARAM_VALUE", where=lambda m: m.param_id == "FS_GCS_TIMEOUT")
         client.close()
         clock.close()
         log = vehicle.stop()
@@ -60,6 +69,7 @@ def test_a_signed_vehicle_obeys_only_signed_traffic(key_file, along, client_key,
     moved = np.linalg.norm(truth_of(last(messages, "SIM_STATE"), frame) - HOME)
     assert moved == pytest.approx(0.5 if obeyed else 0.0, abs=0.02)
     assert (upload is not None) == obeyed
+    assert timeout is not None and timeout.param_value == (7.0 if obeyed else 2.0)  # else: not set
     refused = [line for line in log.splitlines() if "signature" in line]
     if obeyed:
         assert not refused, log

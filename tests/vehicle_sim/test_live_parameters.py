@@ -3,9 +3,14 @@ after FS_GCS_TIMEOUT as set, not as the scenario had it."""
 
 from __future__ import annotations
 
+import contextlib
+import socket
+
 import numpy as np
+import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint
 from mission.link.vehicle_identity import VehicleIdentity
 from vehicle_sim import modes
 from vehicle_sim.vehicle import Vehicle
@@ -38,3 +43,132 @@ def test_the_failsafe_trips_after_the_timeout_set_live(along_world):
     default = along_world.scenario.vehicle.failsafe_s
     assert _failsafe_after_s(along_world, None) == default + along_world.scenario.control.t_cont_s
     assert _failsafe_after_s(along_world, 2 * default) > 2 * default - 1e-9
+
+
+# -- the simulation's knobs, set live ---------------------------------------------------------
+GPS = mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT
+TARGET = mavlink2.MAVLINK_MSG_ID_LANDING_TARGET
+
+
+def _vehicle(world, home, sent=None) -> Vehicle:
+    sink = sent if sent is not None else []
+    return Vehicle(VehicleIdentity.parse("support-1"), world.scenario, world, home, 0, sink.append)
+
+
+def _set(vehicle: Vehicle, name: str, value: float) -> None:
+    kind = vehicle.params.table[vehicle.params.table.index_of(name)].kind
+    vehicle.params.handle(mavlink2.MAVLink_param_set_message(2, 1, name.encode(), value, kind))
+    assert vehicle.params.table.value(name) == value, f"{name} refused"
+
+
+def _fixes(vehicle: Vehicle, count: int) -> np.ndarray:
+    """ENU of ``count`` GPS_RAW_INT, one a step."""
+    points = []
+    for _ in range(count):
+        vehicle.step()
+        message = vehicle.build_stream(GPS)
+        points.append(vehicle.frame.from_degE7(message.lat, message.lon, message.alt / 1000))
+    return np.array(points)
+
+
+ZONE_HOME = np.array([-5.0, 6.5, 8.5])  # inside Along's zone (offset +1 m east)
+OPEN_HOME = np.array([0.0, -10.0, 7.0])
+
+
+def test_the_defaults_give_the_world_s_fix_draw_for_draw(along_world):
+    rng = np.random.default_rng(np.random.SeedSequence([0, 1]).spawn(4)[0])
+    vehicle = _vehicle(along_world, ZONE_HOME)
+    offset = along_world.zone_offset(ZONE_HOME[None])[0]
+    for _ in range(5):
+        vehicle.step()
+        message = vehicle.build_stream(GPS)
+        fix = along_world.gnss.sample_fix(ZONE_HOME, rng, offset)
+        expected = vehicle.frame.to_degE7(fix.position_m)
+        assert (message.lat, message.lon) == expected[:2]
+
+
+def test_glitch_uere_and_multipath_scale_move_the_fix_as_they_say(along_world):
+    healthy = _fixes(_vehicle(along_world, ZONE_HOME), 40)
+    glitched = _vehicle(along_world, ZONE_HOME)
+    _set(glitched, "SIM_GPS1_GLTCH_X", 2e-5)  # degrees of latitude: 2.2 m north
+    _set(glitched, "SIM_GPS1_GLTCH_Z", -3.0)
+    shift = (_fixes(glitched, 40) - healthy).mean(axis=0)
+    np.testing.assert_allclose(shift, [0.0, 2e-5 * 111_320, -3.0], atol=0.05)
+    no_bias = _vehicle(along_world, ZONE_HOME)
+    _set(no_bias, "SIM_MP_SCALE", 0.0)
+    np.testing.assert_allclose((_fixes(no_bias, 40) - healthy).mean(axis=0), [-1, 0, 0], atol=0.01)
+    quiet = _vehicle(along_world, ZONE_HOME)
+    _set(quiet, "SIM_GPS_UERE", 0.0)
+    np.testing.assert_allclose(_fixes(quiet, 5), np.tile(ZONE_HOME + [1, 0, 0], (5, 1)), atol=0.02)
+    noisy = _vehicle(along_world, ZONE_HOME)
+    _set(noisy, "SIM_GPS_UERE", 4 * along_world.scenario.gnss.sigma_uere_m)
+    spread = np.std(_fixes(noisy, 400), axis=0) / np.std(
+        _fixes(_vehicle(along_world, ZONE_HOME), 400), axis=0
+    )
+    np.testing.assert_allclose(spread, 4.0, rtol=0.2)
+
+
+def test_lag_sends_an_older_fix_stamped_now_and_the_rate_is_the_receiver_s(along_world):
+    lagging, healthy = _vehicle(along_world, OPEN_HOME), _vehicle(along_world, OPEN_HOME)
+    _set(lagging, "SIM_GPS1_LAG_MS", 1000)
+    sent, fixes = [], []
+    for _ in range(6):
+        for vehicle, out in ((lagging, sent), (healthy, fixes)):
+            vehicle.step()
+            out.append(vehicle.build_stream(GPS))
+    assert [m.time_usec for m in sent] == [m.time_usec for m in fixes]  # stamped now
+    lagged = round(1.0 / along_world.scenario.control.t_cont_s)  # samples in a second
+    assert [(m.lat, m.lon) for m in sent[lagged:]] == [(m.lat, m.lon) for m in fixes[:-lagged]]
+    slow = _vehicle(along_world, OPEN_HOME)
+    _set(slow, "SIM_GPS1_HZ", 1)
+    assert slow.intervals_s[GPS] == 1.0
+
+
+def test_camera_range_and_noise_and_tracking_noise_and_speed(along_world):
+    work = OPEN_HOME + [4.0, 0.0, 0.0]
+    near = _vehicle(along_world, OPEN_HOME)
+    assert near.observe(work).valid
+    _set(near, "SIM_CAM_RANGE", 3.0)
+    assert not near.observe(work).valid
+    base = _vehicle(along_world, OPEN_HOME)
+    louder = _vehicle(along_world, OPEN_HOME)
+    _set(louder, "SIM_CAM_NOISE", 3.0)
+    errors = [
+        np.std([v.observe(work).relative_m - [4, 0, 0] for _ in range(300)], axis=0)
+        for v in (base, louder)
+    ]
+    np.testing.assert_allclose(errors[1] / errors[0], 3.0, rtol=0.2)
+    mover = _vehicle(along_world, OPEN_HOME)
+    _set(mover, "WPNAV_SPEED", 20.0)  # cm/s
+    _set(mover, "SIM_TRACK_NOISE", 0.0)
+    mover.change_mode(modes.GUIDED)
+    mover.arm(True)
+    mover.kinematics.target = OPEN_HOME + [10.0, 0.0, 0.0]
+    mover.step()
+    assert mover.kinematics.truth[0] - OPEN_HOME[0] == pytest.approx(0.2 * mover.step_s)
+
+
+def test_link_loss_set_live_drops_that_share_of_what_the_vehicle_sends(along_world):
+    receiver = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    receiver.bind(("127.0.0.1", 0))
+    receiver.settimeout(0.2)
+    endpoint = UdpEndpoint(MavlinkCodec(2, 1), link_seed=5)
+    vehicle = _vehicle(along_world, OPEN_HOME)
+    vehicle.on_link_loss = endpoint.set_loss  # as the vehicle's server attaches it
+    try:
+        counts = []
+        for loss in (0.0, 0.5, 0.0):
+            _set(vehicle, "SIM_LINK_LOSS", loss)
+            for _ in range(200):
+                endpoint.send(vehicle.heartbeat(), [receiver.getsockname()])
+            got = 0
+            with contextlib.suppress(TimeoutError):
+                while True:
+                    receiver.recv(512)
+                    got += 1
+            counts.append(got)
+    finally:
+        endpoint.close()
+        receiver.close()
+    assert counts[0] == counts[2] == 200, counts
+    assert 60 < counts[1] < 140, counts  # half of 200, within 5.6 sigma
