@@ -20,7 +20,18 @@ from tests.bad_input.builders import (
     wpl_rows,
 )
 
-FAULT = "faults: [{{at_s: 10, {}}}]\n"
+
+def _fault_case(case: str, fields: str, field: str, problem: str) -> tuple:
+    """A scenario whose one fault is ``{fields}`` (at 10 s unless they say), refused naming
+    ``faults[0].FIELD`` and the problem."""
+    text = f"faults: [{{{'' if 'at_s' in fields else 'at_s: 10, '}{fields}}}]\n"
+    return (
+        case,
+        lambda t: [*RUN, str(scenario_file(t, text))],
+        ["bad.yaml", f"faults[0].{field}", problem],
+    )
+
+
 OVERLAP = (
     "faults:\n"
     "  - {at_s: 10, vehicle: support-2, failure: gps off, duration_s: 30}\n"
@@ -60,53 +71,38 @@ FILE_CASES = [
         ["work.waypoints", "item", "control.clearance_m (1.5 m)"],
     ),
     # --- scripted faults ---------------------------------------------------------------
-    (
-        "faults-unknown-vehicle",
-        lambda t: [
-            *RUN,
-            str(scenario_file(t, FAULT.format("vehicle: support-7, failure: gps off"))),
-        ],
-        ["bad.yaml", "faults[0].vehicle", "no support-7"],
+    _fault_case(
+        "faults-unknown-vehicle", "vehicle: support-7, failure: gps off", "vehicle", "no support-7"
     ),
-    (
+    _fault_case(
         "faults-unknown-parameter",
-        lambda t: [
-            *RUN,
-            str(scenario_file(t, FAULT.format("vehicle: support-1, param: SIM_X, value: 1"))),
-        ],
-        ["bad.yaml", "faults[0].param", "no parameter 'SIM_X'"],
+        "vehicle: work, param: SIM_X, value: 1",
+        "param",
+        "no parameter 'SIM_X'",
     ),
-    (
+    _fault_case(
         "faults-read-only-parameter",
-        lambda t: [
-            *RUN,
-            str(scenario_file(t, FAULT.format("vehicle: work, param: SIM_RADIUS, value: 1"))),
-        ],
-        ["bad.yaml", "faults[0].param", "SIM_RADIUS cannot change during a run"],
+        "vehicle: work, param: SIM_RADIUS, value: 1",
+        "param",
+        "SIM_RADIUS cannot change during a run",
     ),
-    (
+    _fault_case(
         "faults-value-out-of-range",
-        lambda t: [
-            *RUN,
-            str(scenario_file(t, FAULT.format("vehicle: work, param: SIM_MP_SCALE, value: -1"))),
-        ],
-        ["bad.yaml", "faults[0].value", "must be in [0, 10]"],
+        "vehicle: work, param: SIM_MP_SCALE, value: -1",
+        "value",
+        "must be in [0, 10]",
     ),
-    (
+    _fault_case(
         "faults-unknown-failure",
-        lambda t: [
-            *RUN,
-            str(scenario_file(t, FAULT.format("vehicle: support-1, failure: camera garbage"))),
-        ],
-        ["bad.yaml", "faults[0].failure", "a camera failure is one of"],
+        "vehicle: support-1, failure: camera garbage",
+        "failure",
+        "a camera failure is one of",
     ),
-    (
+    _fault_case(
         "faults-past-the-run",
-        lambda t: [
-            *RUN,
-            str(scenario_file(t, "faults: [{at_s: 5000, vehicle: work, failure: gps off}]\n")),
-        ],
-        ["bad.yaml", "faults[0].at_s", "past the run's end"],
+        "at_s: 5000, vehicle: work, failure: gps off",
+        "at_s",
+        "past the run's end",
     ),
     (
         "faults-overlap",
