@@ -73,8 +73,13 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
 
     monkeypatch.setattr(bench, "run_as_command", fake_run)
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    used = iter([0.0, 4.0, 4.0, 9.0, 9.0, 12.0])  # CPU seconds around each run: 4, 5, 3
+    monkeypatch.setattr(bench, "_children_cpu_s", lambda: next(used))
+    monkeypatch.setattr(bench, "python_loop_s", lambda repeats=5: 0.292)  # half as fast
     rows = {r.name: r for r in bench.bench_runs(trials=15, jobs=2, repeats=3)}
     assert rows["realtime_factor_lockstep"].value == 31.0 and rows["realtime_factor_lockstep"].ok
+    assert rows["run_cpu_s"].value == 4.0 and rows["run_cpu_s"].target == "<= 7.0"
+    assert rows["run_cpu_s"].ok  # 4 s <= 3.5 s x 0.292 / 0.146
     assert calls[:3] == [("along", "ac", None)] * 3
     assert calls[3:] == [
         ("along", "ac", False),
