@@ -151,6 +151,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         speedup=clock.speedup,
         link_loss=link.loss,
     )
+    vehicle.on_link_loss = channels.endpoint.set_loss  # SIM_LINK_LOSS, set live
     server.attach(vehicle)
     install_signal_handlers(server.stop, args.exit_with_parent)
     _print_banner(vehicle, channels, clock)

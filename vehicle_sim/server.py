@@ -103,7 +103,6 @@ class VehicleServer:
     def attach(self, vehicle: Vehicle) -> None:
         """Connect the vehicle whose messages this server carries."""
         self.vehicle = vehicle
-        vehicle.on_link_loss = self.endpoint.set_loss
 
     def broadcast(self, message: Any) -> None:
         """Send a message to every peer that has talked to us and every --out address.

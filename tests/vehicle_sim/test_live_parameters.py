@@ -154,7 +154,7 @@ def test_link_loss_set_live_drops_that_share_of_what_the_vehicle_sends(along_wor
     receiver.settimeout(0.2)
     endpoint = UdpEndpoint(MavlinkCodec(2, 1), link_seed=5)
     vehicle = _vehicle(along_world, OPEN_HOME)
-    vehicle.on_link_loss = endpoint.set_loss  # as the vehicle's server attaches it
+    vehicle.on_link_loss = endpoint.set_loss  # as the vehicle process wires it
     try:
         counts = []
         for loss in (0.0, 0.5, 0.0):

@@ -102,3 +102,21 @@ def _said(client: MavClient, name: str) -> list[str]:
     """The STATUSTEXTs about ``name`` that have come (before or after its echo)."""
     client.collect(0.2)
     return [m.text for m in client.seen if m.get_type() == "STATUSTEXT" and name in m.text]
+
+
+def test_link_loss_set_live_thins_what_the_vehicle_sends():
+    """SIM_LINK_LOSS reaches the process's socket: about half of what it sends is lost at 0.5
+    (the echo of the set itself may be, so it is sent until one comes back)."""
+    with vehicle_process("support-1", "--speedup", "8") as running:
+        client = MavClient(running.address)
+        try:
+            assert _read(client, "SIM_LINK_LOSS").param_value == 0.0
+            before = len(client.collect(2.0))
+            echo = None
+            for _ in range(20):
+                echo = echo or _set(client, "SIM_LINK_LOSS", 0.5)
+            assert echo is not None and echo.param_value == 0.5
+            after = len(client.collect(2.0))
+        finally:
+            client.close()
+    assert 0.25 < after / before < 0.75, (before, after)
