@@ -4,11 +4,12 @@ difference against how often NAC's fusion let a support in while it was in a zon
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 from mission.analysis.figures import save_figure
 from mission.studies.results import metric_values, paired
-from mission.studies.spec import StudySpec
+from mission.studies.spec import Point, StudySpec, value_text
 from mission.studies.stats import bootstrap_ci, mean_ci
 
 
@@ -25,9 +26,9 @@ def write_figures(
     written = []
     scenarios = list(dict.fromkeys(r["scenario"] for r in rows))
     for key in spec.swept_keys:
-        values = [p.as_dict().get(key) for p in spec.points]
+        values = [_value(p, key) for p in spec.points]
         if not all(_scalar(v) for v in values) or len(set(map(repr, values))) < 2:
-            continue  # a list or mapping per point, or one value for all: nothing to plot
+            continue  # a mapping per point, or one value for all: nothing to plot
         path = folder / f"metrics-vs-{key}.png"
         _metrics_against(path, spec, rows, scenarios, key, metrics)
         written.append(path)
@@ -43,7 +44,7 @@ def write_figures(
 def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     import matplotlib.pyplot as plt
 
-    values = list(dict.fromkeys(p.as_dict().get(key) for p in spec.points))
+    values = list(dict.fromkeys(_value(p, key) for p in spec.points))
     numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
     positions = {v: (v if numeric else i) for i, v in enumerate(values)}
     varying = _varying_keys(spec)
@@ -75,9 +76,9 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
                     name = method.upper() + (f", {rest}" if rest else "")
                     axis.errorbar(xs, ys, yerr=errors, marker="o", capsize=3, label=name)
             if not numeric:  # a point that does not set the key flies the scenario's default
-                axis.set_xticks(
-                    range(len(values)), ["default" if v is None else str(v) for v in values]
-                )
+                names = ["default" if v is None else str(v) for v in values]
+                axis.set_xticks(range(len(values)), [textwrap.fill(n, 12) for n in names])
+                axis.tick_params(axis="x", labelsize=6)
             axis.set_xlabel(key)
             axis.set_ylabel(label, fontsize=8)
             axis.grid(alpha=0.3)
@@ -102,6 +103,12 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     save_figure(figure, path)
 
 
+def _value(point: Point, key: str) -> object:
+    """A point's value of ``key`` as a figure shows it (a scenario's faults told briefly)."""
+    value = point.as_dict().get(key)
+    return value_text(key, value) if isinstance(value, list) and key == "faults" else value
+
+
 def _scalar(value: object) -> bool:
     return value is None or isinstance(value, str | int | float | bool)
 
@@ -119,10 +126,11 @@ def _lines(
     """{(the other varying keys' values, method): [(point number, this key's value), ...]}."""
     lines: dict[tuple[str, str], list[tuple[int, object]]] = {}
     for number, point in enumerate(spec.points):
-        overrides = point.as_dict()
-        rest = ", ".join(f"{k}={v}" for k, v in point.overrides if k != key and k in varying)
+        rest = ", ".join(
+            f"{k}={value_text(k, v)}" for k, v in point.overrides if k != key and k in varying
+        )
         for method in spec.methods:
-            lines.setdefault((rest, method), []).append((number, overrides.get(key)))
+            lines.setdefault((rest, method), []).append((number, _value(point, key)))
     return lines
 
 

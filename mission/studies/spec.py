@@ -63,10 +63,10 @@ class Point:
     @property
     def label(self) -> str:
         """``key=value, ...`` (``defaults`` for none; ``faults`` told briefly)."""
-        return ", ".join(f"{k}={_value_text(k, v)}" for k, v in self.overrides) or "defaults"
+        return ", ".join(f"{k}={value_text(k, v)}" for k, v in self.overrides) or "defaults"
 
 
-def _value_text(key: str, value: Any) -> str:
+def value_text(key: str, value: Any) -> str:
     """A point's value as its label shows it: a scenario's ``faults:`` entries as
     ``support-1 gps off 10-40 s``, anything else as Python prints it."""
     if key != "faults" or not isinstance(value, list):
