@@ -27,6 +27,12 @@ def raised_voxels(run_dir: Path, world: World, threshold_m: float = RAISED_M) ->
     return {"near_zone": int(raised[near].sum()), "elsewhere": int(raised[~near].sum())}
 
 
+def run_raised_voxels(run_dir: Path, threshold_m: float = RAISED_M) -> dict | None:
+    """:func:`raised_voxels` of a run folder, in the world of the scenario it ran
+    (``scenario.yaml`` beside its tlog)."""
+    return raised_voxels(run_dir, World.load(str(run_dir / "scenario.yaml")), threshold_m)
+
+
 def near_a_zone(world: World) -> np.ndarray:
     """Per voxel of the map grid, whether its centre is within one voxel of a zone's box."""
     grid = world.map_grid()

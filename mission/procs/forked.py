@@ -48,15 +48,17 @@ class ForkedProcess:
     def __init__(self, pid: int) -> None:
         self.pid = pid
         self.returncode: int | None = None
+        self.cpu_s: float | None = None  # user + system CPU of it and its waited-for children
         self._pidfd: int | None = None  # readable once the child has exited (Linux 5.3+)
         self._pidfd_tried = False
 
     def poll(self) -> int | None:
         """The exit status (negative: the signal that ended it), or None while it runs."""
         if self.returncode is None:
-            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            pid, status, usage = os.wait4(self.pid, os.WNOHANG)
             if pid == self.pid:
                 self.returncode = os.waitstatus_to_exitcode(status)
+                self.cpu_s = usage.ru_utime + usage.ru_stime
                 if self._pidfd is not None:
                     os.close(self._pidfd)
                     self._pidfd = None

@@ -111,8 +111,24 @@ def run_mission(
     if watcher is not None:
         watcher.finish()
     summary = _summary(options, scenario, time.monotonic() - start)
+    summary["cpu_s"] = _cpu_seconds(children)
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
+
+
+def _cpu_seconds(children: list[Child]) -> dict[str, float]:
+    """User + system CPU seconds of each forked process of the run (the ground station's with
+    its MPC helper's) and of this one so far (start-up, the run, the analysis); a process
+    started with ``--process-start exec`` is not counted (its rusage is not kept)."""
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    cpu = {"orchestrator": round(usage.ru_utime + usage.ru_stime, 3)}
+    for child in children:
+        used = getattr(child.process, "cpu_s", None)
+        if used is not None:
+            cpu[child.name] = round(used, 3)
+    return cpu
 
 
 def _why(log: Path) -> str:

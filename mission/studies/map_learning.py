@@ -17,23 +17,18 @@ from pathlib import Path
 
 import numpy as np
 
-from mission.analysis.map_learning import RAISED_M, raised_voxels
+from mission.analysis.map_learning import RAISED_M, run_raised_voxels
 from mission.studies.spec import load_study
-from mission.world.model import World
 
 
 def study_table(study_file: Path, out: Path) -> str:
-    """Markdown: the mean of :func:`raised_voxels` per scenario, point and method over the
+    """Markdown: the mean of :func:`run_raised_voxels` per scenario, point and method over the
     runs of ``study_file`` written to ``out``."""
     spec = load_study(study_file)
     counts: dict[tuple[str, int, str], list[dict]] = defaultdict(list)
-    worlds: dict[str, World] = {}
     for row in csv.DictReader((out / "results.csv").open()):
         name = f"{row['scenario']}-{row['method']}-{row['seed']}-{row['run_key'][:10]}"
-        run_dir = out / "runs" / name
-        if row["scenario"] not in worlds:
-            worlds[row["scenario"]] = World.load(str(run_dir / "scenario.yaml"))
-        found = raised_voxels(run_dir, worlds[row["scenario"]])
+        found = run_raised_voxels(out / "runs" / name)
         if found is not None:
             counts[(row["scenario"], int(row["point"]), row["method"])].append(found)
     lines = [

@@ -19,6 +19,7 @@ from mission.studies.spec import StudySpec
 _LEADING = ["scenario", "point", "method", "seed"]
 _TRAILING = ["wall_time_s", "node", "run_key"]
 _SKIPPED = {"scenario", "method", "seed", "scenario_source", "study", "link_events", "link"}
+_SKIPPED |= {"cpu_s"}  # the machine's, like the wall time, and not a metric of the run
 
 
 def result_row(spec: StudySpec, run: StudyRun, summary: dict[str, Any]) -> dict:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import resource
 import shutil
 import signal
 import struct
@@ -31,7 +32,7 @@ world:
   zones:
     - {name: test, min_m: [-14.0, -12.0, 5.0], max_m: [-4.0, -6.0, 11.0], offset_m: [1.0, 0, 0]}
 """
-VOLATILE = {"wall_time_s", "realtime_factor", "mpc_solve_ms"}  # wall-clock figures
+VOLATILE = {"wall_time_s", "realtime_factor", "mpc_solve_ms", "cpu_s"}  # the machine's figures
 LINK_TIMING = {"tick_resends", "late_steps"}  # how often a step was slow: wall-clock too
 
 
@@ -105,7 +106,9 @@ def _analysis_keeps_a_summary_its_tlog_cannot_hold(run: Path, copy: Path) -> Non
 
 
 def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path):
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     result = _run(scenario, tmp_path / "a", "--seed", "2", "--mpc-helper")
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     assert result.returncode == 0, result.stderr
     assert "completed at" in result.stdout
     summary = json.loads((tmp_path / "a" / "summary.json").read_text())
@@ -116,6 +119,11 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert summary["multipath_steps_total"] == sum(summary["multipath_steps"].values())
     assert 0 < summary["work_error_m"]["mean"] < 1.0
     assert summary["mpc_solve_ms"]["median"] > 0
+    cpu = summary["cpu_s"]  # per process; together, what this test saw the run's tree use
+    assert set(cpu) == {"orchestrator", "ground_station", "work", *summary["multipath_steps"]}
+    assert all(seconds > 0 for seconds in cpu.values())
+    used = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+    assert 0.9 * used < sum(cpu.values()) <= used + 0.01, (cpu, used)
     assert (tmp_path / "a" / "gcs.tlog").stat().st_size > 0
     assert _children_of(scenario) == []
     assert _processes_of(tmp_path / "a") == []
@@ -233,12 +241,12 @@ def test_a_dead_work_vehicle_ends_the_run_with_a_clear_error(scenario, tmp_path)
 
 def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_path):
     out = tmp_path / "lossy"
-    result = _run(scenario, out, "--link-loss", "0.2", "--link-delay-ms", "50")
+    result = _run(scenario, out, "--link-loss", "0.2", "--link-delay-ms", "20")
     assert result.returncode == 0, result.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is True
     link = summary["link"]
-    assert (link["loss"], link["delay_ms"]) == (0.2, 50.0)
+    assert (link["loss"], link["delay_ms"]) == (0.2, 20.0)
     # the ground station drops a fifth of what it sends (binomial: +-4 sd over ~450 datagrams:
     # each vehicle's commands and tick leave in one datagram a cycle); lost batches and steps
     # are asked again

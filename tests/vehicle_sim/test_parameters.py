@@ -111,12 +111,12 @@ def test_link_loss_set_live_thins_what_the_vehicle_sends():
         client = MavClient(running.address)
         try:
             assert _read(client, "SIM_LINK_LOSS").param_value == 0.0
-            before = len(client.collect(2.0))
+            before = len(client.collect(1.5))
             echo = None
             for _ in range(20):
                 echo = echo or _set(client, "SIM_LINK_LOSS", 0.5)
             assert echo is not None and echo.param_value == 0.5
-            after = len(client.collect(2.0))
+            after = len(client.collect(1.5))
         finally:
             client.close()
     assert 0.25 < after / before < 0.75, (before, after)
