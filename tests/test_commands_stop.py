@@ -27,6 +27,10 @@ def _group_alive(pgid: int) -> bool:
     return True
 
 
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _busy(out: Path) -> bool:
     """Some run of the command has flown its first cycles."""
     return any(len(p.read_bytes().splitlines()) >= 3 for p in out.rglob("records.jsonl"))
@@ -64,6 +68,9 @@ def test_a_long_command_stops_within_5_s_and_leaves_no_process(tmp_path, command
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         start_new_session=True,
+        # Ctrl-C is tried on a command started as a shell starts a background job: with SIGINT
+        # ignored, so that Python would not turn it into KeyboardInterrupt by itself
+        preexec_fn=_ignore_sigint if sent == signal.SIGINT else None,
     )
     try:
         deadline = time.monotonic() + 120

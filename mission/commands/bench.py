@@ -22,8 +22,10 @@ def add_parser(commands) -> None:
 def bench(args: argparse.Namespace) -> int:
     """``mission bench``."""
     from mission.bench.suite import format_table, run_benchmarks
+    from mission.procs.interrupts import StopRequest
 
-    results = run_benchmarks(args.only)
+    with StopRequest():  # Ctrl-C stops it even where it was started as a background job
+        results = run_benchmarks(args.only)
     if args.json:
         print(json.dumps({r.name: r.value for r in results}))
     else:
