@@ -40,8 +40,14 @@ STREAM_OF = {
     CAMERA: mavlink2.MAVLINK_MSG_ID_LANDING_TARGET,
 }
 UNIT_NAMES = {GPS: "gps", CAMERA: "camera"}
-KIND_NAMES = {OK: "ok", OFF: "off", STUCK: "stuck", GARBAGE: "garbage", WRONG: "wrong"}
-KIND_NAMES[DELAYED] = "delayed"
+KIND_NAMES = {
+    OK: "ok",
+    OFF: "off",
+    STUCK: "stuck",
+    GARBAGE: "garbage",
+    WRONG: "wrong",
+    DELAYED: "delayed",
+}
 WRONG_NORTH_M = 10.0
 WRONG_ANGLE_RAD = 0.1
 DELAY_S = 1.0
@@ -84,7 +90,7 @@ class SensorFailures:
         if kind == OFF:
             return None
         if kind == STUCK:
-            return _restamped(self._stuck.get(message_id), message.time_usec)
+            return restamped(self._stuck.get(message_id), message.time_usec)
         if kind == DELAYED:
             return self._history[0]
         failed = copy.copy(message)
@@ -114,7 +120,7 @@ def parse_failure(name: str) -> tuple[int, int]:
     return units[unit], kinds[kind]
 
 
-def _restamped(message: Any | None, time_usec: int) -> Any | None:
+def restamped(message: Any | None, time_usec: int) -> Any | None:
     """``message`` stamped ``time_usec`` (None if there was no reading to stick at)."""
     if message is None:
         return None

@@ -22,7 +22,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.world.frames import GeodeticFrame
 from mission.world.model import World
 from vehicle_sim import telemetry
-from vehicle_sim.failures import SensorFailures
+from vehicle_sim.failures import SensorFailures, restamped
 from vehicle_sim.parameters import ParameterTable
 
 MAX_LAG_S = 1.0
@@ -78,11 +78,7 @@ class GnssReceiver:
             if earlier.time_usec > due:
                 break
             chosen = earlier
-        if chosen is message:
-            return message
-        restamped = copy.copy(chosen)
-        restamped.time_usec = message.time_usec
-        return restamped
+        return message if chosen is message else restamped(chosen, message.time_usec)
 
 
 def _glitched(message: Any, lat_deg: float, lon_deg: float, alt_m: float) -> Any:

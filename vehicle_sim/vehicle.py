@@ -105,7 +105,7 @@ class Vehicle:
         self._default_intervals = dict(self.intervals_s)
         self._last_sent_s: dict[int, float] = {}
         self.failures = SensorFailures(failure_seed, vs.sensor_hz)
-        self.on_link_loss: Callable[[float], None] | None = None  # the server's, when attached
+        self.on_link_loss: Callable[[float], None] | None = None  # the process's socket, wired in
         self.mission, self.params = self._protocol_servers(speedup, link_loss)
         self.gnss = GnssReceiver(world, self.frame, self.rng_gnss, self.params.table, self.failures)
         self.faults = FaultSchedule(scenario.faults, identity.name)

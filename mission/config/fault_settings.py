@@ -57,12 +57,12 @@ class Fault:
             unit, _, kind = self.failure.partition(" ")
             kinds = FAILURE_TYPES.get(unit)
             require(kinds is not None, "failure", f"unit must be one of {', '.join(FAILURE_TYPES)}")
+            require(kind != "ok", "failure", "a fault is a failure: its end is duration_s")
             require(
-                kind in (*(kinds or ()), "ok"),
+                kind in (kinds or ()),
                 "failure",
                 f"a {unit} failure is one of: {', '.join(kinds or ())}",
             )
-            require(kind != "ok", "failure", "a fault is a failure: its end is duration_s")
             return
         spec = parameter_spec(str(self.param))
         require(

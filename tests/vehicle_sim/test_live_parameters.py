@@ -172,3 +172,21 @@ def test_link_loss_set_live_drops_that_share_of_what_the_vehicle_sends(along_wor
         receiver.close()
     assert counts[0] == counts[2] == 200, counts
     assert 60 < counts[1] < 140, counts  # half of 200, within 5.6 sigma
+
+
+def test_the_scenario_s_failure_names_are_the_vehicle_s():
+    """A fault the scenario accepts is one the vehicle can inject, and the other way round."""
+    from mission.config.fault_settings import FAILURE_TYPES
+    from vehicle_sim import failures
+
+    for unit, kinds in FAILURE_TYPES.items():
+        for kind in kinds:
+            code_unit, code_kind = failures.parse_failure(f"{unit} {kind}")
+            assert code_kind in failures.SUPPORTED[code_unit]
+    offered = {
+        (failures.UNIT_NAMES[unit], failures.KIND_NAMES[kind])
+        for unit, kinds in failures.SUPPORTED.items()
+        for kind in kinds
+        if kind != failures.OK
+    }
+    assert offered == {(u, k) for u, kinds in FAILURE_TYPES.items() for k in kinds}
