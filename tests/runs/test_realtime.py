@@ -50,15 +50,17 @@ def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
     assert summary["measurement_age_ms"] == {"median": 0.0, "p95": 0.0, "max": 0.0}
 
 
-def _independent_pairing(tlog: Path, epoch: float, frame) -> tuple[dict, list, np.ndarray]:
+def _independent_pairing(tlog: Path, epoch: float, frame) -> tuple[dict, list, list, np.ndarray]:
     """Read the tlog with pymavlink; per vehicle, its truth samples at their SYSTEM_TIME
     stamps moved onto the station's clock by the TIMESYNC exchange of shortest round trip;
-    the work UAV's estimates at the cycles' times."""
+    the cycles' times (the work UAV's setpoints); the work UAV's estimates and their times
+    (a blind cycle sends none)."""
     os.environ.setdefault("MAVLINK20", "1")
     from pymavlink import mavutil
 
     log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega")
     pending, stamped, exchanges, estimates, last_estimate = {}, [], {}, [], None
+    cycles = []
     while (message := log.recv_match()) is not None:
         kind, source = message.get_type(), message.get_srcSystem()
         received = message._timestamp - epoch
@@ -74,15 +76,17 @@ def _independent_pairing(tlog: Path, epoch: float, frame) -> tuple[dict, list, n
         elif kind == "VISION_POSITION_ESTIMATE" and source == 255:
             last_estimate = (received, np.array([message.y, message.x, -message.z]))
         elif kind == "SET_POSITION_TARGET_LOCAL_NED" and source == 255:
-            if last_estimate is not None and message.target_system == 1:
-                estimates.append(last_estimate)
+            if message.target_system == 1:
+                cycles.append(received)
+                if last_estimate is not None:
+                    estimates.append(last_estimate)
             last_estimate = None
     tracks: dict[int, tuple[list, list]] = {}
     for source, stamp, position in stamped:
         times, points = tracks.setdefault(source, ([], []))
         times.append(stamp - exchanges[source][1])
         points.append(position)
-    return tracks, [t for t, _ in estimates], np.array([x for _, x in estimates])
+    return tracks, cycles, [t for t, _ in estimates], np.array([x for _, x in estimates])
 
 
 def _at(track: tuple[list, list], times: list[float]) -> np.ndarray:
@@ -109,18 +113,21 @@ def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lo
     assert ages["median"] < 250.0  # cycles a fifth of a step (100 ms) after the vehicles' beat
 
     along = load_scenario("along")
-    tracks, cycles, estimates = _independent_pairing(
+    tracks, cycles, estimated, estimates = _independent_pairing(
         realtime / "gcs.tlog", along.run.epoch_unix_s, GeodeticFrame(along.world.anchor)
     )
     assert len(cycles) == summary["control_cycles"]
+    # a cycle that ends blind (its measurements late, as a loaded machine makes them) sends
+    # the work UAV no estimate
+    assert len(cycles) - len(estimated) == summary["diagnostics"]["blind_cycles"]
     # support-1 crosses the zone: count the cycles within its truth's span whose truth,
     # interpolated at the cycle's time, is inside
     span = [t for t in cycles if min(tracks[2][0]) <= t <= max(tracks[2][0])]
     inside = World(along).in_zone(_at(tracks[2], span))
     assert summary["multipath_steps"]["support-1"] == int(inside.sum()) > 0, summary
-    # the work UAV's error against its truth interpolated at each cycle's time (every cycle
-    # of a completed run lies within the truth's span)
-    errors = np.linalg.norm(estimates - _at(tracks[1], cycles), axis=1)
+    # the work UAV's error against its truth interpolated at each estimate's time (every
+    # cycle of a completed run lies within the truth's span)
+    errors = np.linalg.norm(estimates - _at(tracks[1], estimated), axis=1)
     assert summary["work_error_m"]["mean"] == pytest.approx(float(np.mean(errors)), abs=0.001)
 
     lockstep = tmp_path / "lockstep"
