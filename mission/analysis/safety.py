@@ -141,7 +141,8 @@ def safety_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "cycles_below_clearance": int(below_clearance.sum()),
         "closest_approach_min_m": min(approaches.values(), default=None),
         "least_clearance_min_m": min(clearances.values(), default=None),
-        "contacts": trace.contacts,
+        # by time, then reporter: two vehicles that touch report in either order
+        "contacts": sorted(trace.contacts, key=lambda c: (c["t"], c["vehicle"], c["with"])),
         "contacts_reported": len(trace.contacts),
         "touching_pairs": touching_pairs,
         "touching_vehicles": touching_vehicles,

@@ -49,3 +49,17 @@ def test_diagnostics_count_as_a_hand_count_does(along, along_world):
     assert found["time_beyond_flight_s"] == pytest.approx(300.0 - flight, abs=1e-3)
     trace.completion = None
     assert diagnostics(trace, records, along_world, along)["time_beyond_flight_s"] is None
+
+
+def test_contacts_are_listed_by_time_then_reporter_whatever_order_they_came_in(along, along_world):
+    from mission.analysis.safety import safety_metrics
+
+    trace, _ = _trace(along)
+    touch = {"at_m": [-5.0, 12.0, 8.5], "crash": False}
+    trace.contacts = [  # as a tlog may hold them: two vehicles' reports of one touch interleave
+        {"t": 2.0, "vehicle": "support-2", "with": "support-1", **touch},
+        {"t": 1.5, "vehicle": "support-3", "with": "structure", **touch},
+        {"t": 2.0, "vehicle": "support-1", "with": "support-2", **touch},
+    ]
+    listed = [(c["t"], c["vehicle"]) for c in safety_metrics(trace, along_world)["contacts"]]
+    assert listed == [(1.5, "support-3"), (2.0, "support-1"), (2.0, "support-2")]
