@@ -143,10 +143,14 @@ class VehicleServer:
     def _serve(self, sources: list[Any]) -> None:
         assert self.vehicle is not None
         woken = sources[-1]
+        # The other vehicles' truths are read when a step needs them; only a step waiting for
+        # the work UAV's truth is woken by one (else each truth would wake every vehicle).
+        unless_waiting = [source for source in sources if source is not self.truth_receiver]
         while not self.stopping:
             now = time.monotonic()
             wait = max(0.0, min(MAX_WAIT_WALL_S, self._next_deadline(now) - now))
-            readable, _, _ = select.select(sources, [], [], wait)
+            polled = sources if self._pending_deadline is not None else unless_waiting
+            readable, _, _ = select.select(polled, [], [], wait)
             now = time.monotonic()
             if woken in readable:
                 with contextlib.suppress(OSError):
