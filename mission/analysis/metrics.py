@@ -29,6 +29,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.analysis.safety import safety_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate, truth_time
 from mission.config.settings import Scenario
+from mission.link.fast_decode import FastDecoder
 from mission.link.vehicle_events import parse_event
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame, ned_to_enu
@@ -193,10 +194,11 @@ def _tlog_messages(tlog: Path) -> Iterator[Any]:
     if records is None:
         yield from _mavutil_messages(tlog)
         return
-    parser = mavlink2.MAVLink(None)
+    parser, fast = mavlink2.MAVLink(None), FastDecoder()
     for usec, packet in records:
+        decoded = fast.decode(packet)  # pymavlink's objects, sooner; else pymavlink decides
         try:
-            message = parser.decode(bytearray(packet))
+            message = decoded[0] if decoded else parser.decode(bytearray(packet))
         except mavlink2.MAVError:
             continue  # a corrupt packet: the reference reader drops it too
         message._timestamp = usec * 1.0e-6

@@ -13,6 +13,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.link.fast_decode import FastDecoder
 from mission.link.impairment import ImpairedLink, LinkSettings
 from mission.link.signing import enable_signing, signing_rejections
 
@@ -56,6 +57,7 @@ class MavlinkCodec:
         self.signed = signing_key is not None
         if signing_key is not None:
             enable_signing(self.mav, signing_key)
+        self._fast = None if self.signed else FastDecoder()  # signed packets: pymavlink's
 
     @property
     def signature_rejections(self) -> int:
@@ -77,8 +79,14 @@ class MavlinkCodec:
         """Parse one UDP datagram into messages; return them and the number of bad packets.
 
         Parser state never carries over between datagrams: UDP keeps packets whole, so bytes
-        left over at the end of a datagram are a truncated packet, counted as bad.
+        left over at the end of a datagram are a truncated packet, counted as bad. A datagram
+        of good unsigned packets takes the fast path (:mod:`mission.link.fast_decode`: the
+        same messages); anything else, pymavlink's parser.
         """
+        if self._fast is not None:
+            messages = self._fast.decode(datagram)
+            if messages is not None:
+                return messages, 0
         self._reset()
         try:
             parsed = self.mav.parse_buffer(bytes(datagram)) or []
