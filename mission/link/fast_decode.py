@@ -103,8 +103,7 @@ def _arrangement(kind: type) -> Arrange:
     starts = [sum(lengths[:i]) for i in range(len(lengths))]
     blank = kind.unpacker.unpack(bytes(kind.unpacker.size))  # a char array is one bytes value
     spans = [
-        (starts[order], lengths[order], isinstance(blank[starts[order]], bytes))
-        for order in orders
+        (starts[order], lengths[order], isinstance(blank[starts[order]], bytes)) for order in orders
     ]
 
     def arrange(values: tuple) -> list:

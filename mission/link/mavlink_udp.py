@@ -14,6 +14,7 @@ from typing import Any
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.fast_decode import FastDecoder
+from mission.link.fast_encode import FastEncoder
 from mission.link.impairment import ImpairedLink, LinkSettings
 from mission.link.signing import enable_signing, signing_rejections
 
@@ -57,7 +58,9 @@ class MavlinkCodec:
         self.signed = signing_key is not None
         if signing_key is not None:
             enable_signing(self.mav, signing_key)
-        self._fast = None if self.signed else FastDecoder()  # signed packets: pymavlink's
+        # signed packets: pymavlink's own pack and parser; unsigned: the same bytes, sooner
+        self._fast = None if self.signed else FastDecoder()
+        self._encoder = None if self.signed else FastEncoder(system_id, component_id)
 
     @property
     def signature_rejections(self) -> int:
@@ -71,9 +74,12 @@ class MavlinkCodec:
 
     def encode(self, message: Any) -> bytes:
         """Pack a generated message object as a MAVLink 2 packet from this identity."""
-        packet = message.pack(self.mav)
+        if self._encoder is not None:
+            packet = self._encoder.encode(message, self.mav.seq)
+        else:
+            packet = bytes(message.pack(self.mav))
         self.mav.seq = (self.mav.seq + 1) % 256
-        return bytes(packet)
+        return packet
 
     def decode(self, datagram: bytes) -> tuple[list[Any], int]:
         """Parse one UDP datagram into messages; return them and the number of bad packets.
