@@ -144,3 +144,11 @@ def test_every_message_type_encodes_byte_for_byte_as_pymavlink_packs_it():
             )
             reference.seq = sequence = rng.getrandbits(8)
             assert encoder.encode(message, sequence) == bytes(message.pack(reference)), kind
+
+
+def test_a_short_array_is_refused_as_pymavlink_refuses_it():
+    short = mavlink2.MAVLink_att_pos_mocap_message(1, [1, 0, 0, 0], 0.0, 0.0, 0.0, [0.0] * 20)
+    with pytest.raises(IndexError):
+        short.pack(mavlink2.MAVLink(None, srcSystem=2, srcComponent=1))
+    with pytest.raises(struct.error):
+        FastEncoder(2, 1).encode(short, 0)
