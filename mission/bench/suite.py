@@ -28,6 +28,8 @@ from mission.procs.stopping import stop_processes
 
 REFERENCE_LOOP_S = 0.146  # machine_python_loop_s of the machine issue 34's targets were set on
 RUN_CPU_TARGET_S = 3.5  # CPU seconds of a whole Along AC run there
+REALTIME_FACTOR_TARGET = 100.0  # Along AC's lockstep real-time factor there
+TABLE3_WALL_TARGET_S = 120  # the Table 3 batch on two cores (not scaled: the issue's figure)
 
 
 def bench_sigma0_map(repeats: int = 5) -> list[BenchResult]:
@@ -301,11 +303,25 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     factor = statistics.median(factors)
     estimate = trials * sum(walls) / jobs
     cpu = statistics.median(cpus)
-    cpu_target = RUN_CPU_TARGET_S * python_loop_s() / REFERENCE_LOOP_S  # this machine's speed
+    slowness = python_loop_s() / REFERENCE_LOOP_S  # this machine's speed, after the runs
+    factor_target = REALTIME_FACTOR_TARGET / slowness
+    cpu_target = RUN_CPU_TARGET_S * slowness
     return [
-        BenchResult("realtime_factor_lockstep", factor, "x", ">= 30", factor >= 30),
+        BenchResult(
+            "realtime_factor_lockstep",
+            factor,
+            "x",
+            f">= {factor_target:.0f}",
+            factor >= factor_target,
+        ),
         BenchResult("run_cpu_s", cpu, "s", f"<= {cpu_target:.1f}", cpu <= cpu_target),
-        BenchResult("table3_wall_s_estimate", estimate, "s", "<= 600", estimate <= 600),
+        BenchResult(
+            "table3_wall_s_estimate",
+            estimate,
+            "s",
+            f"<= {TABLE3_WALL_TARGET_S}",
+            estimate <= TABLE3_WALL_TARGET_S,
+        ),
     ]
 
 
