@@ -31,6 +31,8 @@ from mission.procs.cli_common import (
 from mission.procs.outputs import check_output_dir, check_output_file
 from mission.world.model import KnownWorld
 
+G_SNAPSHOT_CHOICES = ("every", "ends", "none")  # ground_station.records.G_SNAPSHOTS (tested)
+
 
 def build_parser() -> OneLineArgumentParser:
     """Arguments of the ground-station process."""
@@ -89,6 +91,13 @@ def build_parser() -> OneLineArgumentParser:
         help="MAVLink 2 signing: 32-byte secret (raw or 64 hex digits)",
     )
     parser.add_argument(
+        "--g-snapshots",
+        choices=G_SNAPSHOT_CHOICES,
+        default="every",
+        help="which snapshots of G to write into OUT/g: every (the start, every 20 cycles and "
+        "the end; the default, what the 3-D view replays), ends (the start and the end), none",
+    )
+    parser.add_argument(
         "--mpc-helper",
         action=argparse.BooleanOptionalAction,
         default=(os.cpu_count() or 1) >= 2,
@@ -136,6 +145,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         signing_key=read_signing_key(args.signing_key) if args.signing_key else None,
         link=link_settings(args),
         mpc_helper=args.mpc_helper,
+        g_snapshots=args.g_snapshots,
     )
     station = GroundStation(world, config)
     host, port = station.links.endpoint.address

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -16,16 +16,26 @@ from ground_station.state import StationState
 from mission.procs.atomic import write_text_atomically
 
 SNAPSHOT_EVERY = 20  # cycles between snapshots of G
+GSnapshots = Literal["every", "ends", "none"]
+G_SNAPSHOTS: tuple[GSnapshots, ...] = ("every", "ends", "none")
+ENDS = ("initial", "final")
 
 
 class RunRecords:
-    """The per-cycle record and G's snapshots, written as the run goes (flushed each cycle)."""
+    """The per-cycle record and G's snapshots, written as the run goes (flushed each cycle).
 
-    def __init__(self, out_dir: Path) -> None:
+    ``g_snapshots``: ``every`` (the start, every SNAPSHOT_EVERY cycles and the end: what the
+    3-D view replays), ``ends`` (the start and the end: what G learned) or ``none``."""
+
+    def __init__(self, out_dir: Path, g_snapshots: GSnapshots = "every") -> None:
+        if g_snapshots not in G_SNAPSHOTS:
+            raise ValueError(f"g_snapshots must be one of {G_SNAPSHOTS}, not {g_snapshots!r}")
         self.out_dir = out_dir
+        self.g_snapshots = g_snapshots
         self._records = (out_dir / "records.jsonl").open("w", encoding="utf-8")
         self._snapshots = out_dir / "g"
-        self._snapshots.mkdir(exist_ok=True)
+        if g_snapshots != "none":
+            self._snapshots.mkdir(exist_ok=True)
 
     def cycle(
         self,
@@ -68,8 +78,11 @@ class RunRecords:
         self._records.flush()
 
     def snapshot(self, g: LocalizabilityMap, label: str) -> None:
-        """G's values as ``g/G_<label>.npy``."""
-        np.save(self._snapshots / f"G_{label}.npy", g.values)
+        """G's values as ``g/G_<label>.npy`` (``initial``, ``final`` or a cycle count), if
+        this run keeps that snapshot."""
+        wanted = self.g_snapshots == "every" or (self.g_snapshots == "ends" and label in ENDS)
+        if wanted:
+            np.save(self._snapshots / f"G_{label}.npy", g.values)
 
     def link_stats(self, stats: dict[str, Any]) -> None:
         """``link.json``."""

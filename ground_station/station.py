@@ -27,7 +27,7 @@ from ground_station.links.tlog import TlogWriter
 from ground_station.links.vehicle_links import VehicleLinks
 from ground_station.localize import SupportReport, reports_from_messages
 from ground_station.preflight import arm_all, connect, upload_missions
-from ground_station.records import SNAPSHOT_EVERY, RunRecords
+from ground_station.records import SNAPSHOT_EVERY, GSnapshots, RunRecords
 from ground_station.run_context import RunContext, build_run_context, require_known_world
 from ground_station.state import StationState
 from ground_station.support_mpc.sharing import MpcHelper
@@ -56,6 +56,7 @@ class StationConfig:
     link_loss_s: float = 3.0  # simulated seconds of silence before a vehicle counts as lost
     link_loss_wall_s: float = 2.0  # real time: and at least this much wall time (a busy CPU)
     connect_timeout_wall_s: float = 30.0
+    g_snapshots: GSnapshots = "every"  # which snapshots of G are written (records.py)
     mpc_helper: bool = False  # share the support MPCs with a helper process (second core)
 
     @property
@@ -84,7 +85,7 @@ class GroundStation:
         )
         config.out_dir.mkdir(parents=True, exist_ok=True)
         self.tlog = TlogWriter(config.tlog_path or config.out_dir / "gcs.tlog")
-        self.records = RunRecords(config.out_dir)
+        self.records = RunRecords(config.out_dir, config.g_snapshots)
         self.links = VehicleLinks(
             config.vehicles, self.clock, self.tlog, config.signing_key, config.link, config.seed
         )

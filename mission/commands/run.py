@@ -51,6 +51,14 @@ def add_parser(commands) -> None:
         "(default: with two or more cores; same results either way)",
     )
     parser.add_argument(
+        "--g-snapshots",
+        choices=["every", "ends", "none"],
+        default="every",
+        help="which snapshots of G the run keeps in OUT/g: every (the start, every 20 cycles "
+        "and the end: what the 3-D view replays; the default), ends (the start and the end: "
+        "what G learned), none (a lean run, as a study's that keeps no g/)",
+    )
+    parser.add_argument(
         "--process-start",
         choices=["fork", "exec"],
         default="fork",
@@ -111,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
         link,
         args.mpc_helper,
         args.process_start,
+        args.g_snapshots,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     live = None

@@ -60,10 +60,13 @@ class RunOptions:
     link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
     mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
     process_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
+    g_snapshots: Literal["every", "ends", "none"] = "every"  # the ground station's G snapshots
 
     def __post_init__(self) -> None:
         if self.process_start not in ("fork", "exec"):
             raise ValueError(f"process_start must be fork or exec, not {self.process_start!r}")
+        if self.g_snapshots not in ("every", "ends", "none"):
+            raise ValueError(f"g_snapshots must be every, ends or none, not {self.g_snapshots!r}")
 
 
 class RunWatcher(Protocol):
@@ -179,7 +182,8 @@ def _start_processes(options: RunOptions, scenario: Scenario, children: list[Chi
     helper = [] if options.mpc_helper is None else [_flag("mpc-helper", options.mpc_helper)]
     forking = options.process_start == "fork" and fork_is_safe()
     station = ["--method", options.method, "--vehicles", addresses]
-    station += ["--out", str(options.out_dir), *helper, *common]
+    station += ["--out", str(options.out_dir), "--g-snapshots", options.g_snapshots]
+    station += [*helper, *common]
     gcs_main = _ground_station_main if forking else None
     gcs = _launch(options.out_dir, "ground_station", station, (), gcs_main)
     children.append(gcs)

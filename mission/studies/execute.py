@@ -36,11 +36,15 @@ def prepare(run: StudyRun, run_dir: Path) -> None:
     (run_dir / SCENARIO_FILE).write_text(yaml.safe_dump(mapping, sort_keys=False))
 
 
-def start(run: StudyRun, run_dir: Path, mpc_helper: bool) -> subprocess.Popen:
+def start(run: StudyRun, run_dir: Path, mpc_helper: bool, keep: Keep = "all") -> subprocess.Popen:
     """``mission run`` of the prepared folder, its output in ``mission.log``; it dies with
-    this process."""
+    this process. A study that keeps no G snapshots (``keep`` logs or summary) has its runs
+    write none."""
+    extra = ["--exit-with-parent"]
+    if keep != "all":
+        extra += ["--g-snapshots", "none"]
     command = mission_run_argv(
-        run_dir / SCENARIO_FILE, run_dir, run.method, run.seed, mpc_helper, ["--exit-with-parent"]
+        run_dir / SCENARIO_FILE, run_dir, run.method, run.seed, mpc_helper, extra
     )
     if run.speedup is not None:
         command += ["--realtime", "--speedup", str(run.speedup)]

@@ -53,7 +53,7 @@ class LocalEngine:
                     while queue and len(running) < self.jobs:
                         run = queue.pop(0)
                         prepare(run, runs_dir / run.folder)
-                        process = start(run, runs_dir / run.folder, mpc_helper)
+                        process = start(run, runs_dir / run.folder, mpc_helper, keep)
                         running[run] = (process, time.monotonic())
                     for run, (process, started) in list(running.items()):
                         if process.poll() is None:

@@ -165,7 +165,7 @@ def run_on_node(run: StudyRun, keep: Keep) -> tuple[dict | None, bytes, float]:
         run_dir = scratch / run.folder
         prepare(run, run_dir)
         started = time.monotonic()
-        status = start(run, run_dir, mpc_helper=False).wait()
+        status = start(run, run_dir, mpc_helper=False, keep=keep).wait()
         wall = time.monotonic() - started
         summary = conclude(run, run_dir, status, node, keep)
         return summary, pack(run_dir), wall

@@ -190,3 +190,16 @@ def test_a_report_written_again_from_results_csv_is_the_report_the_study_wrote(t
     empty.mkdir()
     argv = ["study", str(study_file), "--out", str(empty), "--report-only"]
     assert mission.cli.entry_point(argv) == 2  # no results.csv: nothing to report on
+
+
+def test_runs_whose_g_the_study_drops_write_none(tmp_path, monkeypatch):
+    started = []
+    monkeypatch.setattr(execute.subprocess, "Popen", lambda argv, **_: started.append(argv))
+    run = StudyRun("along", "along", 0, {}, "ac", 3, "k" * 16)
+    for keep in ("all", "logs", "summary"):
+        execute.start(run, tmp_path, mpc_helper=False, keep=keep)
+    lean = [
+        argv[argv.index("--g-snapshots") + 1] if "--g-snapshots" in argv else None
+        for argv in started
+    ]
+    assert lean == [None, "none", "none"]  # keep all: every snapshot, as a plain run
