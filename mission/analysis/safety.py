@@ -62,11 +62,11 @@ def pair_approaches(times: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np
     (time, position of a); NaN where either track is unknown."""
     least = np.full(max(len(times) - 1, 0), np.nan)
     moments: list = [None] * len(least)
+    known = ~(np.isnan(a).any(axis=1) | np.isnan(b).any(axis=1))
     for i in range(len(least)):
-        ends = (a[i], a[i + 1], b[i], b[i + 1])
-        if any(np.isnan(p).any() for p in ends):
+        if not (known[i] and known[i + 1]):
             continue
-        distance, fraction = closest_approach(*ends)
+        distance, fraction = closest_approach(a[i], a[i + 1], b[i], b[i + 1])
         least[i] = distance
         moments[i] = (
             times[i] + fraction * (times[i + 1] - times[i]),
@@ -80,11 +80,20 @@ def track_clearance(
 ) -> tuple[float, float, np.ndarray]:
     """(least clearance from the structure and the ground, its time, where) along a track."""
     best = (np.inf, np.nan, np.full(3, np.nan))
-    for i in range(len(times) - 1):
-        if np.isnan(track[i]).any() or np.isnan(track[i + 1]).any():
-            continue
-        points = segment_points(track[i], track[i + 1], spacing_m)
-        gaps = proximity.clearance(points)
+    known = ~np.isnan(track).any(axis=1)
+    segments = [
+        (i, segment_points(track[i], track[i + 1], spacing_m))
+        for i in range(len(times) - 1)
+        if known[i] and known[i + 1]
+    ]
+    if not segments:
+        return best
+    # every segment's points in one query (a point's clearance does not depend on the others)
+    all_gaps = proximity.clearance(np.vstack([points for _, points in segments]))
+    start = 0
+    for i, points in segments:
+        gaps = all_gaps[start : start + len(points)]
+        start += len(points)
         j = int(np.argmin(gaps))
         if gaps[j] < best[0]:
             when = times[i] + (times[i + 1] - times[i]) * j / max(len(points) - 1, 1)
