@@ -10,14 +10,17 @@ import time
 from pathlib import Path
 
 from mission.bench.result import BenchResult
+from mission.procs.machine_speed import children_cpu_s
 
 BENCH_STUDY = "name: bench\nscenarios: [along]\nmethods: [ac, nac]\nseeds: 10\n"
 JOBS = 2
 
 
 def bench_studies() -> list[BenchResult]:
-    """``study_runs_per_hour`` of the local engine and, with Ray installed,
-    ``ray_over_local_wall_ratio`` (Ray's start and stop included)."""
+    """``study_runs_per_hour`` of the local engine, how busy it kept the cores
+    (``study_core_use``: its runs' CPU seconds over wall seconds x jobs, start-ups and
+    analyses included) and, with Ray installed, ``ray_over_local_wall_ratio`` (Ray's start and
+    stop included)."""
     from mission.studies.local_engine import LocalEngine
     from mission.studies.spec import load_study
 
@@ -25,10 +28,13 @@ def bench_studies() -> list[BenchResult]:
         path = Path(temp) / "bench.yaml"
         path.write_text(BENCH_STUDY)
         spec = load_study(path)
+        before = children_cpu_s()
         local = _wall(spec, Path(temp) / "local", LocalEngine(JOBS))
+        core_use = (children_cpu_s() - before) / (local * min(JOBS, os.cpu_count() or 1))
         per_hour = spec.size / local * 3600
         results = [
             BenchResult("study_runs_per_hour", per_hour, "runs/h", "reference", None),
+            BenchResult("study_core_use", core_use, "", ">= 0.90", core_use >= 0.90),
         ]
         try:
             import ray  # noqa: F401

@@ -23,10 +23,9 @@ from mission.bench.view import bench_view
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.procs.cli_common import child_environment
 from mission.procs.commands import mission_run_argv
-from mission.procs.machine_speed import python_loop_s
+from mission.procs.machine_speed import REFERENCE_LOOP_S, children_cpu_s, python_loop_s
 from mission.procs.stopping import stop_processes
 
-REFERENCE_LOOP_S = 0.146  # machine_python_loop_s of the machine issue 34's targets were set on
 RUN_CPU_TARGET_S = 3.5  # CPU seconds of a whole Along AC run there
 REALTIME_FACTOR_TARGET = 100.0  # Along AC's lockstep real-time factor there
 TABLE3_WALL_TARGET_S = 120  # the Table 3 batch on two cores (not scaled: the issue's figure)
@@ -293,9 +292,9 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
         for repeat in range(repeats):
             out = Path(temp) / f"along-ac-{repeat}"
-            before = _children_cpu_s()
+            before = children_cpu_s()
             factors.append(run_as_command("along", "ac", out)["realtime_factor"])
-            cpus.append(_children_cpu_s() - before)
+            cpus.append(children_cpu_s() - before)
         for name in ("along", "wall"):
             for method in ("ac", "nac"):
                 out = Path(temp) / f"batch-{name}-{method}"
@@ -323,15 +322,6 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
             estimate <= TABLE3_WALL_TARGET_S,
         ),
     ]
-
-
-def _children_cpu_s() -> float:
-    """User and system CPU seconds of every process this one has waited for (a run's
-    processes are waited for by theirs, so they count too)."""
-    import resource
-
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
 
 
 def run_as_command(

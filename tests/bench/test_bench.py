@@ -74,7 +74,7 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     monkeypatch.setattr(bench, "run_as_command", fake_run)
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
     used = iter([0.0, 4.0, 4.0, 9.0, 9.0, 12.0])  # CPU seconds around each run: 4, 5, 3
-    monkeypatch.setattr(bench, "_children_cpu_s", lambda: next(used))
+    monkeypatch.setattr(bench, "children_cpu_s", lambda: next(used))
     monkeypatch.setattr(bench, "python_loop_s", lambda repeats=5: 0.292)  # half as fast
     rows = {r.name: r for r in bench.bench_runs(trials=15, jobs=2, repeats=3)}
     factor = rows["realtime_factor_lockstep"]
@@ -104,13 +104,18 @@ def test_every_invocation_starts_with_the_machines_speed_without_a_verdict(monke
     assert table[2].split()[-1] == "yes"
 
 
-def test_the_study_bench_reports_runs_per_hour_and_the_ray_to_local_ratio(monkeypatch):
+def test_the_study_bench_reports_runs_per_hour_core_use_and_the_ray_to_local_ratio(monkeypatch):
     from mission.bench import study as bench_study
 
     walls = iter([72.0, 75.6])  # local, then Ray
     monkeypatch.setattr(bench_study, "_wall", lambda spec, out, engine: next(walls))
+    used = iter([10.0, 140.0])  # the runs' CPU seconds: 130 in 72 s on two cores
+    monkeypatch.setattr(bench_study, "children_cpu_s", lambda: next(used))
+    monkeypatch.setattr(bench_study.os, "cpu_count", lambda: 2)
     rows = {r.name: r for r in bench_study.bench_studies()}
     assert rows["study_runs_per_hour"].value == pytest.approx(20 / 72.0 * 3600)
+    core_use = rows["study_core_use"]
+    assert core_use.value == pytest.approx(130 / 144) and core_use.ok
     ratio = rows["ray_over_local_wall_ratio"]
     assert ratio.value == pytest.approx(1.05) and ratio.ok
 
