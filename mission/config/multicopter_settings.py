@@ -1,0 +1,61 @@
+"""The rigid body of a simulated multicopter (issue 31): mass, inertia, rotors, drag, and the
+rate it is integrated at.
+
+The defaults are a ~1.5 kg inspection quadrotor, scaled from PX4's SIH defaults for a 1 kg
+quadrotor (``src/modules/simulation/simulator_sih/sih_params.yaml``: SIH_MASS 1.0 kg,
+SIH_IXX/IYY 0.025 and SIH_IZZ 0.03 kg m^2, SIH_T_MAX 5 N and SIH_Q_MAX 0.1 N m per rotor,
+SIH_L_ROLL 0.2 m, SIH_KDV 1.0 N/(m/s), SIH_KDW 0.025 N m/(rad/s), SIH_T_TAU 0.05 s): mass,
+inertia, rotor thrust and torque x 1.5 (the same frame, heavier: thrust-to-weight stays ~2),
+arm, drag and motor lag as SIH has them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mission.config.checks import non_negative as _non_negative
+from mission.config.checks import positive as _positive
+from mission.config.checks import require as _require
+
+MIN_RATE_HZ = 50.0  # below this the motors' 0.05 s lag is not resolved
+STANDARD_GRAVITY = 9.80665
+
+
+@dataclass(frozen=True)
+class MulticopterSettings:
+    """A quadrotor in X configuration, rotors at 45, 135, 225 and 315 degrees from the nose,
+    spinning alternately (front-right counter-clockwise)."""
+
+    mass_kg: float = 1.5
+    inertia_kg_m2: tuple[float, float, float] = (0.0375, 0.0375, 0.045)  # Ixx, Iyy, Izz (body)
+    arm_m: float = 0.2  # centre to each rotor's axis
+    rotor_thrust_max_n: float = 7.5  # one rotor at full command
+    rotor_torque_max_n_m: float = 0.15  # its reaction torque at full command
+    motor_tau_s: float = 0.05  # first-order lag of a rotor's thrust
+    drag_n_per_m_s: float = 1.0  # body drag -k (v - wind), as SIH's KDV
+    rotational_damping_n_m_per_rad_s: float = 0.025  # -k omega, as SIH's KDW
+    rate_hz: float = 250.0  # fixed integration rate within each step
+
+    def __post_init__(self) -> None:
+        _positive(self, "mass_kg", "arm_m", "rotor_thrust_max_n", "motor_tau_s", "rate_hz")
+        _non_negative(self, "rotor_torque_max_n_m", "drag_n_per_m_s")
+        _non_negative(self, "rotational_damping_n_m_per_rad_s")
+        _require(len(self.inertia_kg_m2) == 3, "inertia_kg_m2", "must be [Ixx, Iyy, Izz]")
+        _require(
+            all(value > 0 for value in self.inertia_kg_m2),
+            "inertia_kg_m2",
+            "must be positive (a body with a zero moment of inertia is singular)",
+        )
+        ixx, iyy, izz = self.inertia_kg_m2
+        _require(
+            ixx + iyy >= izz and iyy + izz >= ixx and izz + ixx >= iyy,
+            "inertia_kg_m2",
+            "breaks the triangle inequality of a rigid body's principal moments",
+        )
+        _require(self.rate_hz >= MIN_RATE_HZ, "rate_hz", f"must be at least {MIN_RATE_HZ:g} Hz")
+        hover = self.mass_kg * STANDARD_GRAVITY / 4
+        _require(
+            self.rotor_thrust_max_n > hover,
+            "rotor_thrust_max_n",
+            f"must exceed a quarter of the weight ({hover:.2f} N): it could not hover",
+        )

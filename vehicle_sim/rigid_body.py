@@ -1,0 +1,120 @@
+"""A quadrotor as a rigid body with four lagged rotors (issue 31), as casadi expressions
+integrated over a whole simulation step in one Function call.
+
+The model is PX4 SIH's (``simulator_sih/sih.cpp``): thrust along the body's z axis from four
+rotors whose thrust follows the command with a first-order lag (``motor_tau_s``), moments from
+the rotors' arms and their reaction torques, linear body drag against the air's velocity
+(``-k (v - wind)``) and linear rotational damping (``-k omega``), gravity. Frames: ENU world,
+FLU body (x nose, y left, z up); the attitude is the unit quaternion (w, x, y, z) taking body
+to world.
+
+State (17): position (3, m), velocity (3, m/s), attitude (4), body rates (3, rad/s), rotor
+thrusts (4, N). Inputs over a step: the rotors' commands (4, 0..1) and the wind (3, m/s, world),
+both held over each substep. A step of ``step_s`` is cut into the fewest equal substeps at
+``rate_hz`` or faster, each a classical Runge-Kutta step with the attitude renormalised after
+it, so the same state and inputs give the same result bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from mission.config.multicopter_settings import STANDARD_GRAVITY, MulticopterSettings
+
+STATE_SIZE = 17
+POSITION, VELOCITY, ATTITUDE, RATES, THRUSTS = (
+    slice(0, 3),
+    slice(3, 6),
+    slice(6, 10),
+    slice(10, 13),
+    slice(13, 17),
+)
+# rotor angles from the nose toward the left, and spin: +1 counter-clockwise seen from above
+# (PX4's quad X: front-right and rear-left counter-clockwise)
+ROTOR_ANGLES_DEG = (45.0, 135.0, 225.0, 315.0)
+ROTOR_SPINS = (-1.0, 1.0, -1.0, 1.0)
+
+
+def rotation(q: ca.SX) -> ca.SX:
+    """The rotation matrix of a unit quaternion (w, x, y, z), body to world."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    return ca.vertcat(
+        ca.horzcat(1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+        ca.horzcat(2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+        ca.horzcat(2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
+    )
+
+
+def derivative(settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX):
+    """d(state)/dt of the rigid body under the rotors' ``command`` (clipped to 0..1)."""
+    s = settings
+    velocity, q, rates, thrusts = (state[part] for part in (VELOCITY, ATTITUDE, RATES, THRUSTS))
+    inertia = ca.DM(np.diag(s.inertia_kg_m2))
+    force = rotation(q) @ ca.vertcat(0, 0, ca.sum1(thrusts))
+    force += -s.drag_n_per_m_s * (velocity - wind) - ca.vertcat(0, 0, s.mass_kg * STANDARD_GRAVITY)
+    torque_per_thrust = s.rotor_torque_max_n_m / s.rotor_thrust_max_n
+    moment = -s.rotational_damping_n_m_per_rad_s * rates
+    for angle, spin, thrust in zip(ROTOR_ANGLES_DEG, ROTOR_SPINS, ca.vertsplit(thrusts)):
+        arm_x = s.arm_m * math.cos(math.radians(angle))
+        arm_y = s.arm_m * math.sin(math.radians(angle))
+        # the arm's moment (r x F for F along body z) and the reaction to the rotor's spin
+        moment += ca.vertcat(arm_y * thrust, -arm_x * thrust, -spin * torque_per_thrust * thrust)
+    angular = ca.solve(inertia, moment - ca.cross(rates, inertia @ rates))
+    spin_rate = 0.5 * ca.vertcat(
+        -q[1] * rates[0] - q[2] * rates[1] - q[3] * rates[2],
+        q[0] * rates[0] + q[2] * rates[2] - q[3] * rates[1],
+        q[0] * rates[1] - q[1] * rates[2] + q[3] * rates[0],
+        q[0] * rates[2] + q[1] * rates[1] - q[2] * rates[0],
+    )
+    wanted = s.rotor_thrust_max_n * ca.fmin(ca.fmax(command, 0), 1)
+    lag = (wanted - thrusts) / s.motor_tau_s
+    return ca.vertcat(velocity, force / s.mass_kg, spin_rate, angular, lag)
+
+
+def substeps_of(step_s: float, rate_hz: float) -> int:
+    """The fewest equal substeps of ``step_s`` at ``rate_hz`` or faster."""
+    return max(1, math.ceil(step_s * rate_hz - 1e-9))
+
+
+class RigidBody:
+    """The model's step for one settings and step length: :meth:`advance` integrates it."""
+
+    def __init__(self, settings: MulticopterSettings, step_s: float) -> None:
+        self.settings = settings
+        self.step_s = step_s
+        self.substeps = substeps_of(step_s, settings.rate_hz)
+        h = step_s / self.substeps
+        state, command, wind = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("u", 4), ca.SX.sym("w", 3)
+        k1 = derivative(settings, state, command, wind)
+        k2 = derivative(settings, state + h / 2 * k1, command, wind)
+        k3 = derivative(settings, state + h / 2 * k2, command, wind)
+        k4 = derivative(settings, state + h * k3, command, wind)
+        after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        q = after[ATTITUDE]
+        after = ca.vertcat(after[:6], q / ca.norm_2(q), after[10:])
+        self._step = ca.Function("substep", [state, command, wind], [after]).fold(self.substeps)
+
+    def advance(self, state: np.ndarray, command: np.ndarray, wind: np.ndarray) -> np.ndarray:
+        """The state one step later, ``command`` and ``wind`` held over it."""
+        count = self.substeps
+        result = self._step(
+            np.asarray(state, dtype=float),
+            np.repeat(np.asarray(command, dtype=float).reshape(4, 1), count, axis=1),
+            np.repeat(np.asarray(wind, dtype=float).reshape(3, 1), count, axis=1),
+        )
+        return np.asarray(result, dtype=float).reshape(STATE_SIZE)
+
+
+def resting_state(
+    position: np.ndarray, settings: MulticopterSettings, tilt: np.ndarray | None = None
+) -> np.ndarray:
+    """A state at ``position``, at rest, level (or at the attitude quaternion ``tilt``), each
+    rotor already making a quarter of the weight (divided by the tilt's cosine)."""
+    q = np.array([1.0, 0.0, 0.0, 0.0]) if tilt is None else np.asarray(tilt, dtype=float)
+    up = 1 - 2 * (q[1] ** 2 + q[2] ** 2)  # the body z axis' vertical component
+    thrust = settings.mass_kg * STANDARD_GRAVITY / 4 / up
+    position = np.asarray(position, dtype=float)
+    return np.concatenate([position, np.zeros(3), q, np.zeros(3), [thrust] * 4])
