@@ -59,3 +59,27 @@ class MulticopterSettings:
             "rotor_thrust_max_n",
             f"must exceed a quarter of the weight ({hover:.2f} N): it could not hover",
         )
+
+
+@dataclass(frozen=True)
+class AutopilotSettings:
+    """The position controller's cascade, as ArduPilot's and PX4's multicopter controllers
+    run it: position error -> velocity setpoint (capped at the speed limit) -> acceleration
+    setpoint (capped) -> thrust vector (tilt capped) -> attitude -> body rates -> rotor
+    thrusts. Each gain is the inverse of its loop's time constant; the defaults put the
+    loops a factor ~2.5-4 apart (PX4's MPC_XY_P 0.95, MPC_XY_VEL_P_ACC 1.8, MC_ROLL_P 6.5)."""
+
+    position_gain_per_s: float = 1.0
+    velocity_gain_per_s: float = 2.5
+    attitude_gain_per_s: float = 8.0
+    rate_gain_per_s: float = 25.0
+    acceleration_max_m_s2: float = 5.0
+    tilt_max_deg: float = 35.0
+    rate_max_rad_s: float = 3.5
+
+    def __post_init__(self) -> None:
+        _positive(self, "position_gain_per_s", "velocity_gain_per_s", "attitude_gain_per_s")
+        _positive(
+            self, "rate_gain_per_s", "acceleration_max_m_s2", "tilt_max_deg", "rate_max_rad_s"
+        )
+        _require(self.tilt_max_deg < 90, "tilt_max_deg", "must be less than 90 degrees")

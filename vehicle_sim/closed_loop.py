@@ -1,0 +1,69 @@
+"""The rigid body flown by its autopilot over one simulation step (issue 31): at every substep
+the position controller (:mod:`vehicle_sim.autopilot_loops`) computes the rotors' commands,
+held while the body (:mod:`vehicle_sim.rigid_body`) is integrated over the substep (a
+classical Runge-Kutta step) and the controller's integral by Euler, as a flight controller's
+loop runs at a fixed rate. One casadi Function does a whole step; the same inputs give the
+same state bit for bit.
+
+State (20): the body's 17, then the controller's velocity-error integral (3).
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
+from vehicle_sim.autopilot_loops import motor_commands
+from vehicle_sim.rigid_body import ATTITUDE, STATE_SIZE, derivative, substeps_of
+
+FLIGHT_STATE_SIZE = STATE_SIZE + 3
+INTEGRAL = slice(STATE_SIZE, FLIGHT_STATE_SIZE)
+
+
+class ClosedLoop:
+    """One step of the flown body: :meth:`advance` (state, target, belief offset, speed limit,
+    wind) -> the state a step later."""
+
+    def __init__(self, body: MulticopterSettings, loops: AutopilotSettings, step_s: float) -> None:
+        self.body, self.loops, self.step_s = body, loops, step_s
+        self.substeps = substeps_of(step_s, body.rate_hz)
+        h = step_s / self.substeps
+        flight = ca.SX.sym("x", FLIGHT_STATE_SIZE)
+        target, offset, wind = ca.SX.sym("t", 3), ca.SX.sym("d", 3), ca.SX.sym("w", 3)
+        speed = ca.SX.sym("s")
+        state, integral = flight[:STATE_SIZE], flight[INTEGRAL]
+        command, integral_rate = motor_commands(body, loops, state, integral, target, offset, speed)
+        k1 = derivative(body, state, command, wind)
+        k2 = derivative(body, state + h / 2 * k1, command, wind)
+        k3 = derivative(body, state + h / 2 * k2, command, wind)
+        k4 = derivative(body, state + h * k3, command, wind)
+        after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        q = after[ATTITUDE]
+        after = ca.vertcat(after[:6], q / ca.norm_2(q), after[10:], integral + h * integral_rate)
+        substep = ca.Function("flight", [flight, target, offset, speed, wind], [after, command])
+        self._step = substep.mapaccum(self.substeps)
+
+    def advance(
+        self,
+        state: np.ndarray,
+        target: np.ndarray,
+        belief_offset: np.ndarray,
+        speed_limit_m_s: float,
+        wind: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(the state a step later, the rotors' commands at each substep (4, substeps))."""
+        count = self.substeps
+
+        def held(value, size):
+            return np.repeat(np.asarray(value, dtype=float).reshape(size, 1), count, axis=1)
+
+        states, commands = self._step(
+            np.asarray(state, dtype=float),
+            held(target, 3),
+            held(belief_offset, 3),
+            held(speed_limit_m_s, 1),
+            held(wind, 3),
+        )
+        final = np.asarray(states, dtype=float)[:, -1]
+        return final, np.asarray(commands, dtype=float)
