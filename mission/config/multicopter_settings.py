@@ -26,15 +26,15 @@ class MulticopterSettings:
     """A quadrotor in X configuration, rotors at 45, 135, 225 and 315 degrees from the nose,
     spinning alternately (front-right counter-clockwise)."""
 
-    mass_kg: float = 1.5
-    inertia_kg_m2: tuple[float, float, float] = (0.0375, 0.0375, 0.045)  # Ixx, Iyy, Izz (body)
-    arm_m: float = 0.2  # centre to each rotor's axis
-    rotor_thrust_max_n: float = 7.5  # one rotor at full command
-    rotor_torque_max_n_m: float = 0.15  # its reaction torque at full command
-    motor_tau_s: float = 0.05  # first-order lag of a rotor's thrust
-    drag_n_per_m_s: float = 1.0  # body drag -k (v - wind), as SIH's KDV
-    rotational_damping_n_m_per_rad_s: float = 0.025  # -k omega, as SIH's KDW
-    rate_hz: float = 250.0  # fixed integration rate within each step
+    mass_kg: float
+    inertia_kg_m2: tuple[float, float, float]  # Ixx, Iyy, Izz (body)
+    arm_m: float  # centre to each rotor's axis
+    rotor_thrust_max_n: float  # one rotor at full command
+    rotor_torque_max_n_m: float  # its reaction torque at full command
+    motor_tau_s: float  # first-order lag of a rotor's thrust
+    drag_n_per_m_s: float  # body drag -k (v - wind), as SIH's KDV
+    rotational_damping_n_m_per_rad_s: float  # -k omega, as SIH's KDW
+    rate_hz: float  # fixed integration rate within each step
 
     def __post_init__(self) -> None:
         _positive(self, "mass_kg", "arm_m", "rotor_thrust_max_n", "motor_tau_s", "rate_hz")
@@ -69,13 +69,13 @@ class AutopilotSettings:
     thrusts. Each gain is the inverse of its loop's time constant; the defaults put the
     loops a factor ~2.5-4 apart (PX4's MPC_XY_P 0.95, MPC_XY_VEL_P_ACC 1.8, MC_ROLL_P 6.5)."""
 
-    position_gain_per_s: float = 1.0
-    velocity_gain_per_s: float = 2.5
-    attitude_gain_per_s: float = 8.0
-    rate_gain_per_s: float = 25.0
-    acceleration_max_m_s2: float = 5.0
-    tilt_max_deg: float = 35.0
-    rate_max_rad_s: float = 3.5
+    position_gain_per_s: float
+    velocity_gain_per_s: float
+    attitude_gain_per_s: float
+    rate_gain_per_s: float
+    acceleration_max_m_s2: float
+    tilt_max_deg: float
+    rate_max_rad_s: float
 
     def __post_init__(self) -> None:
         _positive(self, "position_gain_per_s", "velocity_gain_per_s", "attitude_gain_per_s")

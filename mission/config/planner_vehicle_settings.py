@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
+from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
 
 
 @dataclass(frozen=True)
@@ -51,6 +53,9 @@ class VehicleSettings:
     mission_timeout_wall_s: float
     mission_retries: int
     mission_capacity: int
+    dynamics: Literal["kinematic", "multicopter"]
+    multicopter: MulticopterSettings
+    autopilot: AutopilotSettings
 
     def __post_init__(self) -> None:
         _non_negative(self, "tracking_noise_m")

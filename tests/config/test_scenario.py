@@ -133,6 +133,31 @@ BAD_INPUTS = [
     ("bad yaml", "map: {voxel_size_m: [1, 2\n", "line 2, column 1", "but got '<stream end>'"),
     ("not a mapping", "- 1\n- 2\n", "", "must hold a mapping"),
     ("section not mapping", "gnss: 3\n", "gnss", "expected a mapping"),
+    ("unknown dynamics", "vehicle: {dynamics: rocket}\n", "vehicle.dynamics", "must be one of"),
+    (
+        "negative mass",
+        "vehicle: {multicopter: {mass_kg: -1.5}}\n",
+        "vehicle.multicopter.mass_kg",
+        "must be positive",
+    ),
+    (
+        "singular inertia",
+        "vehicle: {multicopter: {inertia_kg_m2: [0.04, 0.04, 0]}}\n",
+        "vehicle.multicopter.inertia_kg_m2",
+        "singular",
+    ),
+    (
+        "integration too slow",
+        "vehicle: {multicopter: {rate_hz: 40}}\n",
+        "vehicle.multicopter.rate_hz",
+        "at least 50",
+    ),
+    (
+        "tilt of 90 degrees",
+        "vehicle: {autopilot: {tilt_max_deg: 90}}\n",
+        "vehicle.autopilot.tilt_max_deg",
+        "less than 90",
+    ),
     (
         "empty structure",
         "world: {structure: {primitives: []}}\n",

@@ -5,17 +5,18 @@ the same flight twice."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
-from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
+from mission.config.scenario import load_scenario
 from vehicle_sim.closed_loop import ClosedLoop
 from vehicle_sim.rigid_body import ATTITUDE, POSITION, THRUSTS, VELOCITY, resting_state
 
-BODY, LOOPS = MulticopterSettings(), AutopilotSettings()
+BODY, LOOPS = load_scenario("along").vehicle.multicopter, load_scenario("along").vehicle.autopilot
 TICK_S = 0.02  # steps this short, to watch the response
 CALM, NO_OFFSET = np.zeros(3), np.zeros(3)
 # What the defaults do with a 1 m step (docs/model.md): no overshoot, within 2 cm in 5 s.
@@ -95,4 +96,4 @@ def test_the_same_flight_twice_is_the_same_bit_for_bit(loop):
 
 def test_a_tilt_limit_of_90_degrees_or_more_is_refused():
     with pytest.raises(FieldProblem, match="less than 90"):
-        AutopilotSettings(tilt_max_deg=90.0)
+        replace(LOOPS, tilt_max_deg=90.0)

@@ -5,13 +5,14 @@ moments, and the settings a body cannot have."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
-from mission.config.multicopter_settings import MulticopterSettings
+from mission.config.scenario import load_scenario
 from vehicle_sim.rigid_body import (
     ATTITUDE,
     POSITION,
@@ -23,7 +24,7 @@ from vehicle_sim.rigid_body import (
     substeps_of,
 )
 
-SETTINGS = MulticopterSettings()
+SETTINGS = load_scenario("along").vehicle.multicopter
 STEP_S = 0.5
 CALM = np.zeros(3)
 
@@ -54,7 +55,7 @@ def test_free_fall_with_the_motors_off_follows_the_drag_law(body):
         -(m * G / k) * (1 - math.exp(-k * 2.0 / m)), abs=1e-6
     )
     # and without drag, g t^2 / 2
-    no_drag = RigidBody(MulticopterSettings(drag_n_per_m_s=0.0), STEP_S)
+    no_drag = RigidBody(replace(SETTINGS, drag_n_per_m_s=0.0), STEP_S)
     assert _fly(no_drag, still, [0] * 4, 2)[2] == pytest.approx(100.0 - G * 1.0**2 / 2, abs=1e-9)
 
 
@@ -125,4 +126,4 @@ def test_the_rotors_moments_turn_the_body_the_right_way(body, more_on, axis, sig
 )
 def test_a_body_that_cannot_be_is_refused(field, value, problem):
     with pytest.raises(FieldProblem, match=problem):
-        MulticopterSettings(**{field: value})
+        replace(SETTINGS, **{field: value})
