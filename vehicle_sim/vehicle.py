@@ -75,7 +75,7 @@ class Vehicle:
         self.rng_gnss = np.random.default_rng(gnss_seed)
         self.rng_camera = np.random.default_rng(camera_seed)
         self.rng_motion = np.random.default_rng(motion_seed)
-        self.kinematics = Kinematics.at(self.home)
+        self.kinematics = _motion(scenario, self.home)
         detector = ContactDetector(StructureProximity(world.structure), scenario.vehicle.radius_m)
         self.watch = ContactWatch(detector, scenario.run.stop_on_crash)
         self._last_move = (as_sent(self.home), as_sent(self.home))  # the last step, as sent
@@ -339,3 +339,13 @@ class Vehicle:
         else:
             self.intervals_s[message_id] = interval_us / 1e6
         return True
+
+
+def _motion(scenario: Scenario, home: np.ndarray) -> Any:
+    """How the vehicle moves: the kinematic point (the default) or the flying quadrotor
+    (imported only then: casadi is no small import for a vehicle that does not need it)."""
+    if scenario.vehicle.dynamics == "multicopter":
+        from vehicle_sim.multicopter import Multicopter
+
+        return Multicopter.at(home, scenario.vehicle, scenario.control.t_cont_s)
+    return Kinematics.at(home)

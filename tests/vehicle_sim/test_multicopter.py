@@ -1,0 +1,61 @@
+"""The flying quadrotor as a vehicle's motion: the kinematic model's interface kept (belief,
+estimate, hold, crash stop, the move it reports), and a real run whose vehicles fly it."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from mission.config.scenario import load_scenario
+from tests.processes import mission
+from vehicle_sim.multicopter import Multicopter
+
+VEHICLE = load_scenario("along").vehicle
+STEP_S = 0.5
+
+
+def test_it_believes_what_the_estimate_says_and_flies_from_there():
+    body = Multicopter.at(np.array([0.0, 0.0, 10.0]), VEHICLE, STEP_S)
+    body.set_estimate(np.array([0.5, 0.0, 10.0]))  # it is told it is 0.5 m east of the truth
+    assert body.believed == pytest.approx([0.5, 0.0, 10.0])
+    body.target = np.array([2.0, 0.0, 10.0])
+    rng = np.random.default_rng(0)
+    moves = [body.step(STEP_S, 3.0, rng, 0.0) for _ in range(30)]
+    assert body.believed == pytest.approx([2.0, 0.0, 10.0], abs=0.02)
+    assert body.truth == pytest.approx([1.5, 0.0, 10.0], abs=0.02)  # where the error takes it
+    assert np.sum(moves, axis=0) == pytest.approx([1.5, 0.0, 0.0], abs=0.02)
+    assert np.linalg.norm(body.velocity) < 0.05
+
+
+def test_holding_stays_and_a_kick_moves_the_truth_not_the_belief():
+    body = Multicopter.at(np.array([0.0, 0.0, 10.0]), VEHICLE, STEP_S)
+    body.hold()
+    believed = body.believed
+    body.step(STEP_S, 3.0, np.random.default_rng(1), 0.3)
+    truth_after_kick = body.truth
+    assert body.believed == pytest.approx(believed, abs=1e-3)
+    assert np.linalg.norm(truth_after_kick - believed) > 0.05
+
+
+def test_a_crash_stops_it_dead_and_a_wrong_step_length_is_refused():
+    body = Multicopter.at(np.array([0.0, 0.0, 10.0]), VEHICLE, STEP_S)
+    body.target = np.array([5.0, 0.0, 10.0])
+    body.step(STEP_S, 3.0, np.random.default_rng(2), 0.0)
+    body.stop_at(np.array([1.0, 2.0, 3.0]))
+    assert body.truth == pytest.approx([1.0, 2.0, 3.0]) and body.target is None
+    assert np.linalg.norm(body.velocity) == 0 and body.believed == pytest.approx(body.truth)
+    with pytest.raises(ValueError, match=r"steps of 0\.5 s"):
+        body.step(0.25, 3.0, np.random.default_rng(2), 0.0)
+
+
+@pytest.mark.slow
+def test_a_run_with_multicopters_flies_its_first_minute(tmp_path):
+    scenario = tmp_path / "flying.yaml"
+    scenario.write_text("extends: along\nvehicle: {dynamics: multicopter}\nrun: {timeout_s: 60}\n")
+    result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["control_cycles"] == 120 and not summary["safety"]["contacts"]
+    assert summary["work_error_m"]["mean"] < 0.5  # the formation localizes a flying work UAV

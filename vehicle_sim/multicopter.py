@@ -1,0 +1,89 @@
+"""A vehicle's motion as a flying quadrotor (``vehicle.dynamics: multicopter``, issue 31): the
+rigid body of :mod:`vehicle_sim.rigid_body` flown by the position controller of
+:mod:`vehicle_sim.autopilot_loops` over each step, with the interface of
+:class:`~vehicle_sim.kinematics.Kinematics` (truth, belief, target, velocity).
+
+The autopilot steers from the position it believes. Its belief is the truth plus an offset
+that each VISION_POSITION_ESTIMATE sets (the estimate's error, as the kinematic model keeps
+it) and that then moves with the vehicle: the navigation filter's drift between estimates is
+not modelled yet. ``vehicle.tracking_noise_m`` still kicks the true position each step, as in
+the kinematic model. No wind yet.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mission.config.planner_vehicle_settings import VehicleSettings
+from vehicle_sim.closed_loop import ClosedLoop
+from vehicle_sim.rigid_body import ATTITUDE, POSITION, RATES, VELOCITY, resting_state
+
+CALM = np.zeros(3)
+
+
+class Multicopter:
+    """True and believed position of one flying quadrotor, its position target and state."""
+
+    def __init__(self, loop: ClosedLoop, home: np.ndarray) -> None:
+        self.loop = loop
+        self.state = np.concatenate([resting_state(home, loop.body), np.zeros(3)])
+        self.offset = np.zeros(3)  # believed - true position
+        self.target: np.ndarray | None = None
+
+    @classmethod
+    def at(cls, home: np.ndarray, vehicle: VehicleSettings, step_s: float) -> Multicopter:
+        """A quadrotor hovering at ``home`` that knows where it is."""
+        loop = ClosedLoop(vehicle.multicopter, vehicle.autopilot, step_s)
+        return cls(loop, np.asarray(home, dtype=float).reshape(3))
+
+    @property
+    def truth(self) -> np.ndarray:
+        """Where it is."""
+        return self.state[POSITION].copy()
+
+    @property
+    def believed(self) -> np.ndarray:
+        """Where its autopilot believes it is."""
+        return self.state[POSITION] + self.offset
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """Its true velocity (ENU, m/s)."""
+        return self.state[VELOCITY].copy()
+
+    @property
+    def attitude(self) -> np.ndarray:
+        """Its attitude quaternion (w, x, y, z), body (FLU) to world (ENU)."""
+        return self.state[ATTITUDE].copy()
+
+    def set_estimate(self, estimate: np.ndarray) -> None:
+        """The navigation estimate streamed by the ground station replaces the belief."""
+        self.offset = np.asarray(estimate, dtype=float).reshape(3) - self.state[POSITION]
+
+    def hold(self) -> None:
+        """Hold where the autopilot believes it is."""
+        self.target = self.believed.copy()
+
+    def stop_at(self, position: np.ndarray) -> None:
+        """Stopped dead at ``position`` (a crash): still, level, believing the truth, no
+        target."""
+        self.state = np.concatenate([resting_state(position, self.loop.body), np.zeros(3)])
+        self.state[RATES] = 0.0
+        self.offset = np.zeros(3)
+        self.target = None
+
+    def step(
+        self, dt_s: float, speed_limit_m_s: float, rng: np.random.Generator, noise_m: float
+    ) -> np.ndarray:
+        """Fly ``dt_s`` (the loop's step) toward the target (none: hold); return the move
+        the autopilot believes it made."""
+        if dt_s != self.loop.step_s:
+            raise ValueError(f"this body flies steps of {self.loop.step_s} s, not {dt_s}")
+        before = self.believed
+        target = before if self.target is None else self.target
+        self.state, _ = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, CALM)
+        if noise_m > 0:  # a kick to the true position the autopilot does not sense
+            kick = rng.normal(0.0, noise_m, 3)
+            self.state[POSITION] += kick
+            self.offset = self.offset - kick
+        return self.believed - before
