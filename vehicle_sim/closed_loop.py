@@ -2,8 +2,8 @@
 the position controller (:mod:`vehicle_sim.autopilot_loops`) computes the rotors' commands,
 held while the body (:mod:`vehicle_sim.rigid_body`) is integrated over the substep (a
 classical Runge-Kutta step) and the controller's integral by Euler, as a flight controller's
-loop runs at a fixed rate. One casadi Function does a whole step; the same inputs give the
-same state bit for bit.
+loop runs at a fixed rate. One casadi Function does a whole step, compiled with the system C
+compiler and cached as the support MPC is; the same inputs give the same state bit for bit.
 
 State (20): the body's 17, then the controller's velocity-error integral (3).
 """
@@ -14,9 +14,11 @@ import casadi as ca
 import numpy as np
 
 from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
+from mission.procs.casadi_cache import Compiling, compiled_function
 from vehicle_sim.autopilot_loops import motor_commands
 from vehicle_sim.rigid_body import ATTITUDE, STATE_SIZE, derivative, substeps_of
 
+DYNAMICS = Compiling("vehicle", "its flight dynamics", "vehicle_flight")
 FLIGHT_STATE_SIZE = STATE_SIZE + 3
 INTEGRAL = slice(STATE_SIZE, FLIGHT_STATE_SIZE)
 
@@ -25,7 +27,15 @@ class ClosedLoop:
     """One step of the flown body: :meth:`advance` (state, target, belief offset, speed limit,
     wind) -> the state a step later."""
 
-    def __init__(self, body: MulticopterSettings, loops: AutopilotSettings, step_s: float) -> None:
+    def __init__(
+        self,
+        body: MulticopterSettings,
+        loops: AutopilotSettings,
+        step_s: float,
+        compiled: bool = True,
+    ) -> None:
+        """``compiled``: with the system C compiler (cached once per machine and settings),
+        else casadi's interpreter (the same states, slower)."""
         self.body, self.loops, self.step_s = body, loops, step_s
         self.substeps = substeps_of(step_s, body.rate_hz)
         h = step_s / self.substeps
@@ -41,8 +51,13 @@ class ClosedLoop:
         after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
         q = after[ATTITUDE]
         after = ca.vertcat(after[:6], q / ca.norm_2(q), after[10:], integral + h * integral_rate)
-        substep = ca.Function("flight", [flight, target, offset, speed, wind], [after, command])
-        self._step = substep.mapaccum(self.substeps)
+        substep = ca.Function("flight", [flight, target, offset, speed, wind], [after])
+        folded = substep.fold(self.substeps)
+        held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1), ("w", 3))]
+        start = ca.MX.sym("x", FLIGHT_STATE_SIZE)
+        final = folded(start, *(ca.repmat(value, 1, self.substeps) for value in held))
+        step = ca.Function("flight_step", [start, *held], [final])
+        self._step = compiled_function(step, DYNAMICS, compiled)
 
     def advance(
         self,
@@ -51,19 +66,7 @@ class ClosedLoop:
         belief_offset: np.ndarray,
         speed_limit_m_s: float,
         wind: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(the state a step later, the rotors' commands at each substep (4, substeps))."""
-        count = self.substeps
-
-        def held(value, size):
-            return np.repeat(np.asarray(value, dtype=float).reshape(size, 1), count, axis=1)
-
-        states, commands = self._step(
-            np.asarray(state, dtype=float),
-            held(target, 3),
-            held(belief_offset, 3),
-            held(speed_limit_m_s, 1),
-            held(wind, 3),
-        )
-        final = np.asarray(states, dtype=float)[:, -1]
-        return final, np.asarray(commands, dtype=float)
+    ) -> np.ndarray:
+        """The state a step later."""
+        final = self._step(state, target, belief_offset, speed_limit_m_s, wind)
+        return np.asarray(final, dtype=float).reshape(FLIGHT_STATE_SIZE)

@@ -81,7 +81,7 @@ class Multicopter:
             raise ValueError(f"this body flies steps of {self.loop.step_s} s, not {dt_s}")
         before = self.believed
         target = before if self.target is None else self.target
-        self.state, _ = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, CALM)
+        self.state = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, CALM)
         if noise_m > 0:  # a kick to the true position the autopilot does not sense
             kick = rng.normal(0.0, noise_m, 3)
             self.state[POSITION] += kick

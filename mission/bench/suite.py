@@ -28,6 +28,7 @@ from mission.procs.stopping import stop_processes
 
 RUN_CPU_TARGET_S = 3.5  # CPU seconds of a whole Along AC run there
 REALTIME_FACTOR_TARGET = 100.0  # Along AC's lockstep real-time factor there
+MULTICOPTER_ALONG = "extends: along\nname: along-multicopter\nvehicle: {dynamics: multicopter}\n"
 TABLE3_WALL_TARGET_S = 120  # the Table 3 batch on two cores (not scaled: the issue's figure)
 
 
@@ -280,26 +281,33 @@ def _scipy_over_casadi_once(world, plan, mpc, g, i: int) -> float | None:
 def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchResult]:
     """Lockstep runs, each a ``python -m mission run`` process as a user or a batch starts it:
     Along AC's real-time factor and CPU seconds (all its processes'), the medians of
-    ``repeats`` runs (MPC helper where there is a core for it); and the wall time of the full
+    ``repeats`` runs (MPC helper where there is a core for it); the real-time factor of the
+    same runs flown by multicopters (alternating with those), against 0.8 of the kinematic
+    one; and the wall time of the full
     Table 3 batch, estimated as trials x (sum of one run per scenario and method, made as the
     batch makes them) / jobs."""
     import tempfile
 
     from mission.studies.local_engine import helper_has_a_core
 
-    factors, walls, cpus = [], [], []
+    factors, walls, cpus, flying = [], [], [], []
     in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)
     with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
-        for repeat in range(repeats):
+        multicopter = Path(temp) / "along-multicopter.yaml"
+        multicopter.write_text(MULTICOPTER_ALONG)
+        for repeat in range(repeats):  # alternately, so the machine's drift touches both
             out = Path(temp) / f"along-ac-{repeat}"
             before = children_cpu_s()
             factors.append(run_as_command("along", "ac", out)["realtime_factor"])
             cpus.append(children_cpu_s() - before)
+            out = Path(temp) / f"along-multicopter-{repeat}"
+            flying.append(run_as_command(str(multicopter), "ac", out)["realtime_factor"])
         for name in ("along", "wall"):
             for method in ("ac", "nac"):
                 out = Path(temp) / f"batch-{name}-{method}"
                 walls.append(run_as_command(name, method, out, in_batch)["wall_time_s"])
     factor = statistics.median(factors)
+    flying_ratio = statistics.median(flying) / factor
     estimate = trials * sum(walls) / jobs
     cpu = statistics.median(cpus)
     slowness = python_loop_s() / REFERENCE_LOOP_S  # this machine's speed, after the runs
@@ -312,6 +320,13 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
             "x",
             f">= {factor_target:.0f}",
             factor >= factor_target,
+        ),
+        BenchResult(
+            "realtime_factor_multicopter",
+            statistics.median(flying),
+            "x",
+            f">= 0.8 x {factor:.1f}",
+            flying_ratio >= 0.8,
         ),
         BenchResult("run_cpu_s", cpu, "s", f"<= {cpu_target:.1f}", cpu <= cpu_target),
         BenchResult(

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
@@ -63,11 +64,15 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     import os
 
     factors = iter([20.0, 51.0, 55.0])  # median 51: not the first, last or mean
+    flying = iter([45.0, 40.0, 30.0])  # median 40: 0.78 of 51
     calls = []
 
     def fake_run(scenario, method, out, mpc_helper=None):
         calls.append((scenario, method, mpc_helper))
-        if len(calls) <= 3:
+        if scenario.endswith("along-multicopter.yaml"):
+            assert "dynamics: multicopter" in Path(scenario).read_text()
+            return {"realtime_factor": next(flying), "wall_time_s": 12.0}
+        if len(calls) <= 6:
             return {"realtime_factor": next(factors), "wall_time_s": 9.0}
         return {"realtime_factor": 1.0, "wall_time_s": {"along": 10.0, "wall": 12.0}[scenario]}
 
@@ -81,8 +86,10 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     assert factor.value == 51.0 and factor.target == ">= 50" and factor.ok  # 100 x 0.146 / 0.292
     assert rows["run_cpu_s"].value == 4.0 and rows["run_cpu_s"].target == "<= 7.0"
     assert rows["run_cpu_s"].ok  # 4 s <= 3.5 s x 0.292 / 0.146
-    assert calls[:3] == [("along", "ac", None)] * 3
-    assert calls[3:] == [
+    assert [c[0] for c in calls[:6:2]] == ["along"] * 3  # alternating with the multicopter
+    multicopter = rows["realtime_factor_multicopter"]
+    assert multicopter.value == 40.0 and not multicopter.ok  # 40 < 0.8 x 51
+    assert calls[6:] == [
         ("along", "ac", False),
         ("along", "nac", False),
         ("wall", "ac", False),

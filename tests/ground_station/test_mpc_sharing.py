@@ -103,12 +103,12 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
     IPOPT's algorithm, and the interpreter evaluates the same functions."""
     from dataclasses import replace as replaced
 
-    from ground_station.support_mpc import nlp_cache
+    from mission.procs import casadi_cache
 
     def no_compiling(*_):
         raise AssertionError("compiled=False compiles nothing")
 
-    monkeypatch.setattr(nlp_cache, "compiled_nlps", no_compiling)  # the margins' too
+    monkeypatch.setattr(casadi_cache, "compiled_builds", no_compiling)  # the margins' too
     control = replaced(along_world.scenario.control, mpc_solver=solver)
     sigma0 = along_world.sigma0_map().sigma_m
     interpreted = SupportMpc(

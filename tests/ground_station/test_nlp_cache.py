@@ -55,8 +55,6 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
 
     import casadi as ca
 
-    from ground_station.support_mpc import nlp_cache
-
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     scratch = tmp_path / "tmp"
     scratch.mkdir()
@@ -81,9 +79,11 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
     def no_solver(*args, **kwargs):
         raise AssertionError("a cache hit builds no solver from the expressions")
 
+    from mission.procs import casadi_cache
+
     with monkeypatch.context() as hit:
-        hit.setattr(nlp_cache.tempfile, "TemporaryDirectory", no_scratch)
-        hit.setattr(nlp_cache.ca, "nlpsol", no_solver)
+        hit.setattr(casadi_cache.tempfile, "TemporaryDirectory", no_scratch)
+        hit.setattr(casadi_cache.ca, "nlpsol", no_solver)
         again, _ = _tiny_solver()  # the same NLP, built afresh
         assert _compiled_one("tiny", "ipopt", again, options, no_fallback) == first
     assert Path(first).stat().st_mtime_ns == mtime
@@ -118,6 +118,7 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
     import casadi as ca
 
     from ground_station.support_mpc import nlp_cache
+    from mission.procs import casadi_cache
 
     if c_compiler() is None:
         return
@@ -132,7 +133,7 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
         launched.append(popen(*args, **kwargs))
         return launched[-1]
 
-    monkeypatch.setattr(nlp_cache.subprocess, "Popen", counting)
+    monkeypatch.setattr(casadi_cache.subprocess, "Popen", counting)
 
     def builds(*nlps):
         return [nlp_cache.NlpBuild("tiny", "ipopt", n, options) for n in nlps]

@@ -36,7 +36,7 @@ def _start(position) -> np.ndarray:
 def _fly(loop, state, target, seconds, speed=3.0, wind=CALM, offset=NO_OFFSET):
     track = []
     for _ in range(round(seconds / TICK_S)):
-        state, _ = loop.advance(state, np.asarray(target, dtype=float), offset, speed, wind)
+        state = loop.advance(state, np.asarray(target, dtype=float), offset, speed, wind)
         track.append(state.copy())
     return state, np.array(track)
 
@@ -97,3 +97,13 @@ def test_the_same_flight_twice_is_the_same_bit_for_bit(loop):
 def test_a_tilt_limit_of_90_degrees_or_more_is_refused():
     with pytest.raises(FieldProblem, match="less than 90"):
         replace(LOOPS, tilt_max_deg=90.0)
+
+
+def test_compiled_and_interpreted_fly_the_same_bit_for_bit(loop):
+    interpreted = ClosedLoop(BODY, LOOPS, TICK_S, compiled=False)
+    start, target = _start([0.0, 0.0, 10.0]), np.array([2.0, -1.0, 11.0])
+    a = b = start
+    for _ in range(25):
+        a = loop.advance(a, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
+        b = interpreted.advance(b, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
+    assert np.array_equal(a, b) and not np.array_equal(a, start)
