@@ -56,6 +56,11 @@ class Multicopter:
         """Its attitude quaternion (w, x, y, z), body (FLU) to world (ENU)."""
         return self.state[ATTITUDE].copy()
 
+    @property
+    def rates(self) -> np.ndarray:
+        """Its body rates (FLU, rad/s)."""
+        return self.state[RATES].copy()
+
     def set_estimate(self, estimate: np.ndarray) -> None:
         """The navigation estimate streamed by the ground station replaces the belief."""
         self.offset = np.asarray(estimate, dtype=float).reshape(3) - self.state[POSITION]

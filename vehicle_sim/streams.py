@@ -17,7 +17,12 @@ def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -
     publishes nothing (:mod:`~vehicle_sim.failures`)."""
     k = vehicle.kinematics
     if message_id == mavlink2.MAVLINK_MSG_ID_SIM_STATE:
-        return telemetry.sim_state(k.truth, k.velocity, vehicle.frame)
+        return telemetry.sim_state(k.truth, k.velocity, vehicle.frame, _attitude(k))
+    if message_id == mavlink2.MAVLINK_MSG_ID_ATTITUDE:
+        attitude = _attitude(k)
+        return (
+            None if attitude is None else telemetry.attitude_message(attitude, vehicle.time_boot_ms)
+        )
     if message_id == mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED:
         return telemetry.local_position_ned(k.believed, k.velocity, vehicle.time_boot_ms)
     if message_id == mavlink2.MAVLINK_MSG_ID_GLOBAL_POSITION_INT:
@@ -46,3 +51,11 @@ def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -
     if message_id == mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION:
         return telemetry.autopilot_version(vehicle.identity.system_id)
     raise KeyError(message_id)
+
+
+def _attitude(motion: Any) -> telemetry.Attitude | None:
+    """A flying body's attitude and rates (None for the kinematic point, which has none)."""
+    quaternion, rates = getattr(motion, "attitude", None), getattr(motion, "rates", None)
+    if quaternion is None or rates is None:
+        return None
+    return telemetry.Attitude.of(quaternion, rates)

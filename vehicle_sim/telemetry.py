@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
@@ -171,26 +172,80 @@ def global_position_int(
     )
 
 
+# ENU world -> NED world, and FLU body -> FRD body (MAVLink's frames)
+_ENU_TO_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+_FLU_TO_FRD = np.diag([1.0, -1.0, -1.0])
+
+
+@dataclass(frozen=True)
+class Attitude:
+    """An attitude as MAVLink reports it: the quaternion (w, x, y, z) of body FRD to world NED,
+    roll, pitch and yaw (rad, ZYX) and the body rates (rad/s, FRD)."""
+
+    quaternion: tuple[float, float, float, float]
+    euler: tuple[float, float, float]
+    rates: tuple[float, float, float]
+
+    @classmethod
+    def of(cls, quaternion_enu_flu: np.ndarray, rates_flu: np.ndarray) -> Attitude:
+        """From the simulation's frames (body FLU to world ENU, rates in FLU)."""
+        w, x, y, z = (float(v) for v in quaternion_enu_flu)
+        enu = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        r = _ENU_TO_NED @ enu @ _FLU_TO_FRD
+        roll = math.atan2(r[2, 1], r[2, 2])
+        pitch = math.asin(max(-1.0, min(1.0, -r[2, 0])))
+        yaw = math.atan2(r[1, 0], r[0, 0])
+        qw = math.sqrt(max(0.0, 1 + r[0, 0] + r[1, 1] + r[2, 2])) / 2
+        if qw > 1e-6:
+            q = (
+                qw,
+                (r[2, 1] - r[1, 2]) / (4 * qw),
+                (r[0, 2] - r[2, 0]) / (4 * qw),
+                (r[1, 0] - r[0, 1]) / (4 * qw),
+            )
+        else:  # a half turn: from the largest diagonal term
+            i = int(np.argmax(np.diag(r)))
+            j, k = (i + 1) % 3, (i + 2) % 3
+            v = [0.0, 0.0, 0.0]
+            v[i] = math.sqrt(max(0.0, 1 + r[i, i] - r[j, j] - r[k, k])) / 2
+            v[j] = (r[j, i] + r[i, j]) / (4 * v[i])
+            v[k] = (r[k, i] + r[i, k]) / (4 * v[i])
+            q = ((r[k, j] - r[j, k]) / (4 * v[i]), *v)
+        p, q_rate, r_rate = (float(v) for v in _FLU_TO_FRD @ np.asarray(rates_flu, dtype=float))
+        return cls(tuple(float(v) for v in q), (roll, pitch, yaw), (p, q_rate, r_rate))
+
+
+def attitude_message(attitude: Attitude, time_boot_ms: int) -> mavlink2.MAVLink_attitude_message:
+    """ATTITUDE: what MAVProxy's and QGroundControl's attitude displays read."""
+    return mavlink2.MAVLink_attitude_message(time_boot_ms, *attitude.euler, *attitude.rates)
+
+
 def sim_state(
-    truth_enu: np.ndarray, velocity_enu: np.ndarray, frame: GeodeticFrame
+    truth_enu: np.ndarray,
+    velocity_enu: np.ndarray,
+    frame: GeodeticFrame,
+    attitude: Attitude | None = None,
 ) -> mavlink2.MAVLink_sim_state_message:
-    """SIM_STATE with the true position (lat_int/lon_int carry centimetre resolution)."""
+    """SIM_STATE with the true position (lat_int/lon_int carry centimetre resolution), velocity
+    and, for a flying body, attitude and rates (a kinematic point: level, north)."""
     lat, lon, alt = frame.to_geodetic(truth_enu)
     vn, ve, vd = (float(v) for v in enu_to_ned(velocity_enu))
+    q = (1.0, 0.0, 0.0, 0.0) if attitude is None else attitude.quaternion
+    euler = (0.0, 0.0, 0.0) if attitude is None else attitude.euler
+    rates = (0.0, 0.0, 0.0) if attitude is None else attitude.rates
     return mavlink2.MAVLink_sim_state_message(
-        1,
+        *q,
+        *euler,
         0,
         0,
         0,
-        0,
-        0,
-        0,
-        0,
-        0,
-        0,
-        0,
-        0,
-        0,
+        *rates,
         lat,
         lon,
         alt,

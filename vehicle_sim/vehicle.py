@@ -41,6 +41,7 @@ SENSOR_STREAMS = (
     mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT,
     mavlink2.MAVLINK_MSG_ID_LANDING_TARGET,
 )
+FLYING_STREAMS = (mavlink2.MAVLINK_MSG_ID_ATTITUDE,)  # a multicopter's, at the sensor rate
 STATUS_STREAMS = (
     mavlink2.MAVLINK_MSG_ID_HEARTBEAT,
     mavlink2.MAVLINK_MSG_ID_SYS_STATUS,
@@ -100,6 +101,8 @@ class Vehicle:
             mavlink2.MAVLINK_MSG_ID_SYS_STATUS: 1.0 / vs.status_hz,
             mavlink2.MAVLINK_MSG_ID_MISSION_CURRENT: 1.0 / vs.status_hz,
         }
+        if vs.dynamics == "multicopter":
+            self.intervals_s.update({m: 1.0 / vs.sensor_hz for m in FLYING_STREAMS})
         if identity.is_work:  # the work UAV carries no camera looking at itself
             del self.intervals_s[mavlink2.MAVLINK_MSG_ID_LANDING_TARGET]
         self._default_intervals = dict(self.intervals_s)
@@ -195,7 +198,7 @@ class Vehicle:
     def publish(self, work_truth: np.ndarray | None) -> None:
         """Send every stream that is due at the current simulated time, then SYSTEM_TIME."""
         due = {m for m, interval in self.intervals_s.items() if self._due(m, interval)}
-        for message_id in (*SENSOR_STREAMS, *STATUS_STREAMS):
+        for message_id in (*SENSOR_STREAMS, *FLYING_STREAMS, *STATUS_STREAMS):
             if message_id in due:
                 message = self.build_stream(message_id, work_truth)
                 if message is not None:  # None: a failed sensor publishes nothing

@@ -59,3 +59,41 @@ def test_a_run_with_multicopters_flies_its_first_minute(tmp_path):
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["control_cycles"] == 120 and not summary["safety"]["contacts"]
     assert summary["work_error_m"]["mean"] < 0.5  # the formation localizes a flying work UAV
+    import os
+
+    os.environ.setdefault("MAVLINK20", "1")
+    from pymavlink import mavutil
+
+    tlog = mavutil.mavlink_connection(str(tmp_path / "run" / "gcs.tlog"), dialect="ardupilotmega")
+    tilts, attitudes = [], 0
+    while (message := tlog.recv_match(type=["ATTITUDE", "SIM_STATE"])) is not None:
+        if message.get_type() == "ATTITUDE":
+            attitudes += 1
+        else:
+            tilts.append(max(abs(message.roll), abs(message.pitch)))
+    assert attitudes >= 4 * 100  # every vehicle, every step
+    assert 0.01 < max(tilts) < np.radians(35.5)  # they lean to move, within the tilt limit
+
+
+def test_the_attitude_is_reported_in_mavlinks_frames():
+    from scipy.spatial.transform import Rotation
+
+    from vehicle_sim.telemetry import Attitude
+
+    enu_to_ned = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+    flu_to_frd = np.diag([1.0, -1.0, -1.0])
+    level = Attitude.of(np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3))
+    assert level.euler == pytest.approx((0.0, 0.0, np.pi / 2))  # the nose east: yaw 90 degrees
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        rates = rng.normal(size=3)
+        found = Attitude.of(q, rates)
+        body = Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_matrix()
+        ned = Rotation.from_matrix(enu_to_ned @ body @ flu_to_frd)
+        yaw, pitch, roll = ned.as_euler("ZYX")
+        assert found.euler == pytest.approx((roll, pitch, yaw), abs=1e-9)
+        x, y, z, w = ned.as_quat()
+        assert abs(np.dot(found.quaternion, (w, x, y, z))) == pytest.approx(1.0, abs=1e-9)
+        assert found.rates == pytest.approx(tuple(flu_to_frd @ rates))
