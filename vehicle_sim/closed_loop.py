@@ -53,10 +53,11 @@ class ClosedLoop:
         after = ca.vertcat(after[:6], q / ca.norm_2(q), after[10:], integral + h * integral_rate)
         substep = ca.Function("flight", [flight, target, offset, speed, wind], [after])
         folded = substep.fold(self.substeps)
-        held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1), ("w", 3))]
+        held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1))]
+        gusty = ca.MX.sym("w", 3, self.substeps)  # the wind at each substep
         start = ca.MX.sym("x", FLIGHT_STATE_SIZE)
-        final = folded(start, *(ca.repmat(value, 1, self.substeps) for value in held))
-        step = ca.Function("flight_step", [start, *held], [final])
+        final = folded(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
+        step = ca.Function("flight_step", [start, *held, gusty], [final])
         self._step = compiled_function(step, DYNAMICS, compiled)
 
     def advance(
@@ -67,6 +68,9 @@ class ClosedLoop:
         speed_limit_m_s: float,
         wind: np.ndarray,
     ) -> np.ndarray:
-        """The state a step later."""
-        final = self._step(state, target, belief_offset, speed_limit_m_s, wind)
+        """The state a step later; ``wind`` (3,) held over the step, or (substeps, 3) one
+        vector a substep."""
+        wind = np.asarray(wind, dtype=float)
+        winds = np.repeat(wind.reshape(3, 1), self.substeps, axis=1) if wind.ndim == 1 else wind.T
+        final = self._step(state, target, belief_offset, speed_limit_m_s, winds)
         return np.asarray(final, dtype=float).reshape(FLIGHT_STATE_SIZE)

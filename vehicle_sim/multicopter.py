@@ -7,7 +7,8 @@ The autopilot steers from the position it believes. Its belief is the truth plus
 that each VISION_POSITION_ESTIMATE sets (the estimate's error, as the kinematic model keeps
 it) and that then moves with the vehicle: the navigation filter's drift between estimates is
 not modelled yet. ``vehicle.tracking_noise_m`` still kicks the true position each step, as in
-the kinematic model. No wind yet.
+the kinematic model. The wind (:mod:`mission.world.wind`) is sampled at the vehicle's true
+position at the start of each step, one vector a substep.
 """
 
 from __future__ import annotations
@@ -15,6 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from mission.config.planner_vehicle_settings import VehicleSettings
+from mission.config.settings import BoxPrimitive
+from mission.config.wind_settings import WindSettings
+from mission.world.wind import VehicleWind
 from vehicle_sim.closed_loop import ClosedLoop
 from vehicle_sim.rigid_body import ATTITUDE, POSITION, RATES, VELOCITY, resting_state
 
@@ -24,17 +28,32 @@ CALM = np.zeros(3)
 class Multicopter:
     """True and believed position of one flying quadrotor, its position target and state."""
 
-    def __init__(self, loop: ClosedLoop, home: np.ndarray) -> None:
+    def __init__(self, loop: ClosedLoop, home: np.ndarray, wind: VehicleWind | None = None) -> None:
         self.loop = loop
+        self.wind = wind  # None: still air
         self.state = np.concatenate([resting_state(home, loop.body), np.zeros(3)])
         self.offset = np.zeros(3)  # believed - true position
         self.target: np.ndarray | None = None
 
     @classmethod
-    def at(cls, home: np.ndarray, vehicle: VehicleSettings, step_s: float) -> Multicopter:
-        """A quadrotor hovering at ``home`` that knows where it is."""
+    def at(
+        cls,
+        home: np.ndarray,
+        vehicle: VehicleSettings,
+        step_s: float,
+        wind: WindSettings | None = None,
+        boxes: list[BoxPrimitive] | None = None,
+        rng: np.random.Generator | None = None,
+    ) -> Multicopter:
+        """A quadrotor hovering at ``home`` that knows where it is, in ``wind`` around the
+        structure's ``boxes`` (its gusts drawn from ``rng``), or in still air."""
         loop = ClosedLoop(vehicle.multicopter, vehicle.autopilot, step_s)
-        return cls(loop, np.asarray(home, dtype=float).reshape(3))
+        home = np.asarray(home, dtype=float).reshape(3)
+        weather = None
+        if wind is not None and rng is not None:
+            dt = step_s / loop.substeps
+            weather = VehicleWind.of(wind, boxes or [], float(home[2]), dt, rng)
+        return cls(loop, home, weather)
 
     @property
     def truth(self) -> np.ndarray:
@@ -86,7 +105,8 @@ class Multicopter:
             raise ValueError(f"this body flies steps of {self.loop.step_s} s, not {dt_s}")
         before = self.believed
         target = before if self.target is None else self.target
-        self.state = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, CALM)
+        wind = CALM if self.wind is None else self.wind.over_step(self.truth, self.loop.substeps)
+        self.state = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, wind)
         if noise_m > 0:  # a kick to the true position the autopilot does not sense
             kick = rng.normal(0.0, noise_m, 3)
             self.state[POSITION] += kick

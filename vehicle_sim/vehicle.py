@@ -70,13 +70,14 @@ class Vehicle:
         self.home = np.asarray(home_enu, dtype=float).reshape(3)
         self.send = send
         # the fourth child is new: the first three are what they always were
-        gnss_seed, camera_seed, motion_seed, failure_seed = np.random.SeedSequence(
+        # spawned children depend on their index only: the fifth leaves the four as they were
+        gnss_seed, camera_seed, motion_seed, failure_seed, wind_seed = np.random.SeedSequence(
             [seed, identity.instance]
-        ).spawn(4)
+        ).spawn(5)
         self.rng_gnss = np.random.default_rng(gnss_seed)
         self.rng_camera = np.random.default_rng(camera_seed)
         self.rng_motion = np.random.default_rng(motion_seed)
-        self.kinematics = _motion(scenario, self.home)
+        self.kinematics = _motion(world, self.home, np.random.default_rng(wind_seed))
         detector = ContactDetector(StructureProximity(world.structure), scenario.vehicle.radius_m)
         self.watch = ContactWatch(detector, scenario.run.stop_on_crash)
         self._last_move = (as_sent(self.home), as_sent(self.home))  # the last step, as sent
@@ -344,11 +345,20 @@ class Vehicle:
         return True
 
 
-def _motion(scenario: Scenario, home: np.ndarray) -> Any:
-    """How the vehicle moves: the kinematic point (the default) or the flying quadrotor
-    (imported only then: casadi is no small import for a vehicle that does not need it)."""
+def _motion(world: World, home: np.ndarray, wind_rng: np.random.Generator) -> Any:
+    """How the vehicle moves: the kinematic point (the default) or the flying quadrotor in the
+    scenario's wind (imported only then: casadi is no small import for a vehicle that does
+    not need it)."""
+    scenario = world.scenario
     if scenario.vehicle.dynamics == "multicopter":
         from vehicle_sim.multicopter import Multicopter
 
-        return Multicopter.at(home, scenario.vehicle, scenario.control.t_cont_s)
+        return Multicopter.at(
+            home,
+            scenario.vehicle,
+            scenario.control.t_cont_s,
+            scenario.world.wind,
+            list(world.structure.boxes),
+            wind_rng,
+        )
     return Kinematics.at(home)

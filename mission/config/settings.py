@@ -18,6 +18,7 @@ from mission.config.errors import FieldProblem
 from mission.config.fault_settings import Fault, check_faults
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
+from mission.config.wind_settings import WindSettings
 
 Vec3 = tuple[float, float, float]
 MAX_COORDINATE_M = 100_000.0  # a world-frame coordinate beyond this is not a site's metres
@@ -128,8 +129,16 @@ class WorldSettings:
     workspace: Box
     structure: StructureSettings
     zones: list[Zone]
+    wind: WindSettings
 
     def __post_init__(self) -> None:
+        extent = min(b - a for a, b in zip(self.workspace.min_m, self.workspace.max_m))
+        _require(
+            self.wind.edge_width_m < extent / 2,
+            "wind.edge_width_m",
+            f"{self.wind.edge_width_m:g} m does not fit the workspace (its smallest extent is "
+            f"{extent:g} m)",
+        )
         for i, zone in enumerate(self.zones):
             _require(
                 self.workspace.contains_box(zone.box),

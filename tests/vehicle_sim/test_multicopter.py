@@ -97,3 +97,25 @@ def test_the_attitude_is_reported_in_mavlinks_frames():
         x, y, z, w = ned.as_quat()
         assert abs(np.dot(found.quaternion, (w, x, y, z))) == pytest.approx(1.0, abs=1e-9)
         assert found.rates == pytest.approx(tuple(flu_to_frd @ rates))
+
+
+def test_a_hovering_quadrotor_holds_its_place_in_gusts_that_push_it():
+    from dataclasses import replace
+
+    scenario = load_scenario("along")
+    # 3 m/s with its gusts: within what it can hold (acceleration_max_m_s2 x m / k = 7.5 m/s)
+    gusty = replace(scenario.world.wind, speed_m_s=3.0)
+    home = np.array([0.0, 12.0, 6.0])  # in the open, north of the deck
+    flown = Multicopter.at(home, VEHICLE, STEP_S, gusty, [], np.random.default_rng(9))
+    flown.hold()
+    track = [flown.truth]
+    for _ in range(120):  # a minute
+        flown.step(STEP_S, 3.0, np.random.default_rng(0), 0.0)
+        track.append(flown.truth)
+    drift = np.linalg.norm(np.array(track) - home, axis=1)
+    assert 0.02 < drift.max() < 0.5  # pushed about, never far
+    again = Multicopter.at(home, VEHICLE, STEP_S, gusty, [], np.random.default_rng(9))
+    again.hold()
+    for _ in range(120):
+        again.step(STEP_S, 3.0, np.random.default_rng(0), 0.0)
+    assert np.array_equal(again.truth, track[-1])  # the same gusts for the same seed

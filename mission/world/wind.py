@@ -1,0 +1,172 @@
+"""The wind a flying vehicle feels around the bridge (issue 31): a mean wind, shaped by the
+structure, with Dryden turbulence.
+
+**The field** (:class:`WindField`) is crude and says so: no flow is solved. A box of the
+structure that does not touch the ground is a deck, one that does is a pier. Under a deck
+(inside its footprint, below its underside) the wind is sheltered, a wake: the local speed is
+``shelter + (1 - shelter) exp(-d / edge_width_m)`` of the free stream, d the horizontal
+distance in from the footprint's nearest edge. Around a deck's edges (outside the footprint,
+within ``edge_width_m`` of it horizontally and of its height band vertically) and around the
+piers (within ``edge_width_m`` of one horizontally, below the deck) the flow speeds up past
+the bluff body: ``edge_gain`` times the free stream. Elsewhere the free stream. The direction
+is the free stream's everywhere. A structure from a mesh file shapes nothing (no boxes).
+
+**The turbulence** (:class:`DrydenGusts`) is MIL-F-8785C's low-altitude Dryden model (as
+RotorPy's ``DrydenGust`` and MATLAB's Dryden block use it), per axis along the mean wind,
+across it and vertically: intensity ``sigma_w = turbulence x 0.1 x W20`` with
+``sigma_u = sigma_v = sigma_w / (0.177 + 0.000823 h)^0.4`` and scale lengths
+``L_u = L_v = h / (0.177 + 0.000823 h)^1.2``, ``L_w = h`` (h in feet, at least 10 ft),
+``W20`` the mean speed at 20 ft (the scenario's speed), the frozen turbulence carried past at
+the mean speed (at least 0.5 m/s). Shaping filters
+``H_u = sigma_u sqrt(2 L_u / (pi V)) / (1 + (L_u / V) s)`` and
+``H_v,w = sigma sqrt(L / (pi V)) (1 + sqrt(3) (L / V) s) / (1 + (L / V) s)^2``, discretised
+(zero-order hold) at the integration rate and driven by seeded white noise; each vehicle has
+its own draw, so gusts are not correlated between vehicles. The gust scales with the local
+speed (the shelter calms it, the edges strengthen it).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+from scipy import signal
+
+from mission.config.settings import BoxPrimitive
+from mission.config.wind_settings import WindSettings
+
+FEET = 0.3048
+MIN_HEIGHT_FT = 10.0
+MIN_SPEED_M_S = 0.5
+
+
+class WindField:
+    """The mean wind at a point (ENU, m/s) and the factor the structure puts on it."""
+
+    def __init__(self, settings: WindSettings, boxes: list[BoxPrimitive]) -> None:
+        self.settings = settings
+        bearing = math.radians(settings.from_deg)
+        self.free_stream = -settings.speed_m_s * np.array(
+            [math.sin(bearing), math.cos(bearing), 0.0]
+        )
+        self.decks = [b for b in boxes if b.min_m[2] > 0]
+        self.piers = [b for b in boxes if b.min_m[2] <= 0]
+
+    def factor(self, point: np.ndarray) -> float:
+        """The local speed over the free stream's at ``point``."""
+        s = self.settings
+        x, y, z = (float(v) for v in point)
+        for deck in self.decks:
+            (x0, y0, z0), (x1, y1, z1) = deck.min_m, deck.max_m
+            inside = x0 <= x <= x1 and y0 <= y <= y1
+            if inside and z < z0:
+                depth = min(x - x0, x1 - x, y - y0, y1 - y)
+                return s.shelter + (1 - s.shelter) * math.exp(-depth / s.edge_width_m)
+            outside = math.hypot(max(x0 - x, 0, x - x1), max(y0 - y, 0, y - y1))
+            if (
+                not inside
+                and outside <= s.edge_width_m
+                and z0 - s.edge_width_m <= z <= z1 + s.edge_width_m
+            ):
+                return s.edge_gain
+        for pier in self.piers:
+            (x0, y0, _), (x1, y1, z1) = pier.min_m, pier.max_m
+            outside = math.hypot(max(x0 - x, 0, x - x1), max(y0 - y, 0, y - y1))
+            if outside <= s.edge_width_m and z <= z1:
+                return s.edge_gain
+        return 1.0
+
+    def mean_at(self, point: np.ndarray) -> np.ndarray:
+        """The mean wind at ``point``."""
+        return self.factor(point) * self.free_stream
+
+
+def dryden_filters(
+    speed_m_s: float, height_m: float, turbulence: float, dt_s: float
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The three axes' discrete shaping filters (b, a): along the mean wind, across it, up;
+    each turns unit white noise samples into gust samples (m/s)."""
+    v = max(speed_m_s, MIN_SPEED_M_S)
+    h_ft = max(height_m / FEET, MIN_HEIGHT_FT)
+    sigma_w = turbulence * 0.1 * speed_m_s
+    sigma_uv = sigma_w / (0.177 + 0.000823 * h_ft) ** 0.4
+    length_uv = h_ft / (0.177 + 0.000823 * h_ft) ** 1.2 * FEET
+    length_w = h_ft * FEET
+    filters = []
+    for axis, (sigma, length) in enumerate(
+        [(sigma_uv, length_uv), (sigma_uv, length_uv), (sigma_w, length_w)]
+    ):
+        tau = length / v
+        if axis == 0:
+            numerator = [sigma * math.sqrt(2 * length / (math.pi * v))]
+            denominator = [tau, 1.0]
+        else:
+            gain = sigma * math.sqrt(length / (math.pi * v))
+            numerator = [gain * math.sqrt(3) * tau, gain]
+            denominator = [tau * tau, 2 * tau, 1.0]
+        with warnings.catch_warnings():  # a zero-order hold's numerator starts with a zero
+            warnings.simplefilter("ignore", signal.BadCoefficients)
+            b, a, _ = signal.cont2discrete((numerator, denominator), dt_s, method="zoh")
+        filters.append((np.ravel(b), np.ravel(a)))
+    return filters
+
+
+class DrydenGusts:
+    """One vehicle's turbulence: gust samples (ENU, m/s) at a fixed rate, continuing from one
+    call to the next, from its own seeded generator."""
+
+    def __init__(
+        self,
+        settings: WindSettings,
+        height_m: float,
+        dt_s: float,
+        rng: np.random.Generator,
+    ) -> None:
+        self.dt_s = dt_s
+        self.rng = rng
+        self.filters = dryden_filters(settings.speed_m_s, height_m, settings.turbulence, dt_s)
+        self.state = [np.zeros(max(len(a), len(b)) - 1) for b, a in self.filters]
+        bearing = math.radians(settings.from_deg)
+        along = -np.array([math.sin(bearing), math.cos(bearing), 0.0])
+        across = np.array([-along[1], along[0], 0.0])
+        self.axes = np.column_stack([along, across, [0.0, 0.0, 1.0]])
+        # discrete white noise whose spectrum matches the continuous unit one-sided density
+        self.noise_scale = math.sqrt(math.pi / dt_s)
+
+    def samples(self, count: int) -> np.ndarray:
+        """(count, 3): the next ``count`` gust vectors."""
+        noise = self.rng.standard_normal((3, count)) * self.noise_scale
+        gusts = np.empty((3, count))
+        for axis, (b, a) in enumerate(self.filters):
+            gusts[axis], self.state[axis] = signal.lfilter(b, a, noise[axis], zi=self.state[axis])
+        return (self.axes @ gusts).T
+
+
+class VehicleWind:
+    """The wind one vehicle flies through: the field's local factor at its position times the
+    free stream plus its gusts, one vector per substep."""
+
+    def __init__(self, field: WindField, gusts: DrydenGusts) -> None:
+        self.field = field
+        self.gusts = gusts
+
+    @classmethod
+    def of(
+        cls,
+        settings: WindSettings,
+        boxes: list[BoxPrimitive],
+        height_m: float,
+        dt_s: float,
+        rng: np.random.Generator,
+    ) -> VehicleWind:
+        """A vehicle's wind, its gusts' scale lengths set by its height."""
+        return cls(WindField(settings, boxes), DrydenGusts(settings, height_m, dt_s, rng))
+
+    def over_step(self, position: np.ndarray, count: int) -> np.ndarray:
+        """(count, 3): the wind at ``position`` over the next ``count`` substeps (still air:
+        zeros, and no draw)."""
+        if self.field.settings.speed_m_s == 0:
+            return np.zeros((count, 3))
+        factor = self.field.factor(position)
+        return factor * (self.field.free_stream + self.gusts.samples(count))
