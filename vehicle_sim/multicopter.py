@@ -55,6 +55,15 @@ class Multicopter:
             weather = VehicleWind.of(wind, boxes or [], float(home[2]), dt, rng)
         return cls(loop, home, weather)
 
+    def set_wind(self, settings: WindSettings) -> None:
+        """The wind from now on: the same as before, or a new one (its gusts start afresh from
+        the same generator; still air without a generator)."""
+        if self.wind is None or settings == self.wind.field.settings:
+            return
+        self.wind = VehicleWind.of(
+            settings, self.wind.boxes, self.wind.height_m, self.wind.gusts.dt_s, self.wind.gusts.rng
+        )
+
     @property
     def truth(self) -> np.ndarray:
         """Where it is."""

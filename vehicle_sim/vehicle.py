@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.config.settings import Scenario
+from mission.config.wind_settings import WindSettings
 from mission.link.mavlink_udp import LinkCounters
 from mission.link.vehicle_events import event_text, parameter_change
 from mission.link.vehicle_identity import VehicleIdentity
@@ -253,6 +255,8 @@ class Vehicle:
         if self.armed and self.mode == modes.AUTO:
             fly_mission(self)
         start, start_s = self.kinematics.truth.copy(), self.sim_time_s
+        if self.armed and hasattr(self.kinematics, "set_wind"):  # a multicopter feels it
+            self.kinematics.set_wind(self._wind_now())
         if self.armed:
             self.kinematics.step(
                 self.step_s,
@@ -270,6 +274,16 @@ class Vehicle:
         self._last_move = (as_sent(start), as_sent(self.kinematics.truth))
         if len(self.faults):
             self._apply_faults()
+
+    def _wind_now(self) -> WindSettings:
+        """The scenario's wind as SIM_WIND_SPD, _DIR and _DRYDEN say it is now."""
+        value = self.params.table.value
+        return replace(
+            self.scenario.world.wind,
+            speed_m_s=value("SIM_WIND_SPD"),
+            from_deg=value("SIM_WIND_DIR") % 360,
+            turbulence=value("SIM_WIND_DRYDEN"),
+        )
 
     def _report(self, contacts: list[Contact]) -> None:
         """Say what was touched; a crash stops the vehicle where it touched and disarms it."""

@@ -2,7 +2,9 @@
 during a run.
 
 Ids follow ArduPilot where it has the same setting (``WPNAV_SPEED``, ``FS_GCS_TIMEOUT``,
-``SR0_*``, ``SIM_GPS1_*``), our own ``SIM_*`` where it has none. The vehicle builds its table
+``SR0_*``, ``SIM_GPS1_*``, ``SIM_WIND_SPD``, ``SIM_WIND_DIR``), our own ``SIM_*`` where it has
+none (ArduPilot's ``SIM_WIND_TURB`` is an amplitude in m/s; ours, ``SIM_WIND_DRYDEN``, scales
+MIL-F-8785C's intensities). The vehicle builds its table
 from this catalogue and the scenario (``vehicle_sim.parameters``); a scenario's ``faults:``
 are checked against it before any process starts. docs/vehicle.md lists every entry.
 """
@@ -77,6 +79,11 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     _live("SIM_CAM_RANGE", False, 0, 1000, "the camera's range, m (camera.range_m)"),
     _live("SIM_CAM_NOISE", False, 0, 100, "scale of the camera's noise (1: camera.sigma_*)"),
     _live("SIM_TRACK_NOISE", False, 0, 10, "tracking noise per step, m (vehicle.tracking_noise_m)"),
+    _live("SIM_WIND_SPD", False, 0, 40, "the mean wind, m/s (world.wind.speed_m_s; multicopters)"),
+    _live(
+        "SIM_WIND_DIR", False, 0, 360, "where the wind blows from, degrees (world.wind.from_deg)"
+    ),
+    _live("SIM_WIND_DRYDEN", False, 0, 10, "scale of the Dryden gusts (world.wind.turbulence)"),
     _live("SIM_LINK_LOSS", False, 0, 0.9, "chance a datagram sent is lost (--link-loss)"),
     _fixed("SIM_RADIUS", False, "the body's radius for contact, m (vehicle.radius_m)"),
     _live("SIM_FAIL_ENABLE", True, 0, 1, "1 allows MAV_CMD_INJECT_FAILURE (PX4's SYS_FAILURE_EN)"),

@@ -147,9 +147,13 @@ class VehicleWind:
     """The wind one vehicle flies through: the field's local factor at its position times the
     free stream plus its gusts, one vector per substep."""
 
-    def __init__(self, field: WindField, gusts: DrydenGusts) -> None:
+    def __init__(
+        self, field: WindField, gusts: DrydenGusts, boxes: list[BoxPrimitive], height_m: float
+    ) -> None:
         self.field = field
         self.gusts = gusts
+        self.boxes = boxes  # what the field was made from, to make it again
+        self.height_m = height_m
 
     @classmethod
     def of(
@@ -161,7 +165,8 @@ class VehicleWind:
         rng: np.random.Generator,
     ) -> VehicleWind:
         """A vehicle's wind, its gusts' scale lengths set by its height."""
-        return cls(WindField(settings, boxes), DrydenGusts(settings, height_m, dt_s, rng))
+        gusts = DrydenGusts(settings, height_m, dt_s, rng)
+        return cls(WindField(settings, boxes), gusts, boxes, height_m)
 
     def over_step(self, position: np.ndarray, count: int) -> np.ndarray:
         """(count, 3): the wind at ``position`` over the next ``count`` substeps (still air:

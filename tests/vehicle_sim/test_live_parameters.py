@@ -190,3 +190,35 @@ def test_the_scenario_s_failure_names_are_the_vehicle_s():
         if kind != failures.OK
     }
     assert offered == {(u, k) for u, kinds in FAILURE_TYPES.items() for k in kinds}
+
+
+def test_a_wind_set_live_pushes_a_multicopter_and_not_a_kinematic_point(along_world):
+    from dataclasses import replace
+
+    from mission.world.model import World
+
+    flying = World(
+        replace(
+            along_world.scenario,
+            vehicle=replace(along_world.scenario.vehicle, dynamics="multicopter"),
+        )
+    )
+    home = np.array([0.0, 12.0, 6.0])  # in the open
+
+    def drift(world, wind_m_s: float | None) -> float:
+        vehicle = _vehicle(world, home)
+        vehicle.change_mode(modes.GUIDED)
+        vehicle.arm(True)
+        vehicle.kinematics.hold()
+        if wind_m_s is not None:
+            _set(vehicle, "SIM_WIND_SPD", wind_m_s)
+            _set(vehicle, "SIM_WIND_DIR", 90.0)  # from the east: it blows west
+        east = []
+        for _ in range(6):  # 3 s: before the failsafe (2 s) holds it, and after
+            vehicle.step()
+            east.append(vehicle.kinematics.truth[0] - home[0])
+        return min(east)
+
+    assert drift(flying, None) == pytest.approx(0.0, abs=1e-6)  # still air: it stays
+    assert drift(flying, 6.0) < -0.05  # blown west before the autopilot catches it
+    assert drift(along_world, 6.0) == 0.0  # a kinematic point feels no wind
