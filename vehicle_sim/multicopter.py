@@ -3,12 +3,13 @@ rigid body of :mod:`vehicle_sim.rigid_body` flown by the position controller of
 :mod:`vehicle_sim.autopilot_loops` over each step, with the interface of
 :class:`~vehicle_sim.kinematics.Kinematics` (truth, belief, target, velocity).
 
-The autopilot steers from the position it believes. Its belief is the truth plus an offset
-that each VISION_POSITION_ESTIMATE sets (the estimate's error, as the kinematic model keeps
-it) and that then moves with the vehicle: the navigation filter's drift between estimates is
-not modelled yet. ``vehicle.tracking_noise_m`` still kicks the true position each step, as in
-the kinematic model. The wind (:mod:`mission.world.wind`) is sampled at the vehicle's true
-position at the start of each step, one vector a substep.
+The autopilot steers from the position it believes. Its belief is the truth plus an offset that
+each VISION_POSITION_ESTIMATE sets (the estimate's error, as the kinematic model keeps it);
+between estimates the belief follows the vehicle by its navigation filter's velocity, the true
+one plus a bias (per run and axis) and noise (per step): the offset drifts.
+``vehicle.tracking_noise_m`` still kicks the true position each step, as in the kinematic
+model. The wind (:mod:`mission.world.wind`) is sampled at the vehicle's true position at the
+start of each step, one vector a substep.
 """
 
 from __future__ import annotations
@@ -28,9 +29,20 @@ CALM = np.zeros(3)
 class Multicopter:
     """True and believed position of one flying quadrotor, its position target and state."""
 
-    def __init__(self, loop: ClosedLoop, home: np.ndarray, wind: VehicleWind | None = None) -> None:
+    def __init__(
+        self,
+        loop: ClosedLoop,
+        home: np.ndarray,
+        wind: VehicleWind | None = None,
+        drift_rng: np.random.Generator | None = None,
+    ) -> None:
         self.loop = loop
         self.wind = wind  # None: still air
+        loops = loop.loops
+        self.drift_rng = drift_rng  # None: the belief moves with the truth exactly
+        self.velocity_bias = (
+            np.zeros(3) if drift_rng is None else drift_rng.normal(0.0, loops.velocity_bias_m_s, 3)
+        )
         self.state = np.concatenate([resting_state(home, loop.body), np.zeros(3)])
         self.offset = np.zeros(3)  # believed - true position
         self.target: np.ndarray | None = None
@@ -44,16 +56,19 @@ class Multicopter:
         wind: WindSettings | None = None,
         boxes: list[BoxPrimitive] | None = None,
         rng: np.random.Generator | None = None,
+        drift_rng: np.random.Generator | None = None,
     ) -> Multicopter:
         """A quadrotor hovering at ``home`` that knows where it is, in ``wind`` around the
-        structure's ``boxes`` (its gusts drawn from ``rng``), or in still air."""
+        structure's ``boxes`` (its gusts drawn from ``rng``), or in still air; its belief
+        drifting between estimates by the filter's velocity error (drawn from ``drift_rng``),
+        or not at all."""
         loop = ClosedLoop(vehicle.multicopter, vehicle.autopilot, step_s)
         home = np.asarray(home, dtype=float).reshape(3)
         weather = None
         if wind is not None and rng is not None:
             dt = step_s / loop.substeps
             weather = VehicleWind.of(wind, boxes or [], float(home[2]), dt, rng)
-        return cls(loop, home, weather)
+        return cls(loop, home, weather, drift_rng)
 
     def set_wind(self, settings: WindSettings) -> None:
         """The wind from now on: the same as before, or a new one (its gusts start afresh from
@@ -116,6 +131,9 @@ class Multicopter:
         target = before if self.target is None else self.target
         wind = CALM if self.wind is None else self.wind.over_step(self.truth, self.loop.substeps)
         self.state = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, wind)
+        if self.drift_rng is not None:  # the filter's velocity error, integrated over the step
+            noise = self.drift_rng.normal(0.0, self.loop.loops.velocity_noise_m_s, 3)
+            self.offset = self.offset + (self.velocity_bias + noise) * dt_s
         if noise_m > 0:  # a kick to the true position the autopilot does not sense
             kick = rng.normal(0.0, noise_m, 3)
             self.state[POSITION] += kick

@@ -73,13 +73,14 @@ class Vehicle:
         self.send = send
         # the fourth child is new: the first three are what they always were
         # spawned children depend on their index only: the fifth leaves the four as they were
-        gnss_seed, camera_seed, motion_seed, failure_seed, wind_seed = np.random.SeedSequence(
-            [seed, identity.instance]
-        ).spawn(5)
+        seeds = np.random.SeedSequence([seed, identity.instance]).spawn(6)
+        gnss_seed, camera_seed, motion_seed, failure_seed, wind_seed, drift_seed = seeds
         self.rng_gnss = np.random.default_rng(gnss_seed)
         self.rng_camera = np.random.default_rng(camera_seed)
         self.rng_motion = np.random.default_rng(motion_seed)
-        self.kinematics = _motion(world, self.home, np.random.default_rng(wind_seed))
+        self.kinematics = _motion(
+            world, self.home, np.random.default_rng(wind_seed), np.random.default_rng(drift_seed)
+        )
         detector = ContactDetector(StructureProximity(world.structure), scenario.vehicle.radius_m)
         self.watch = ContactWatch(detector, scenario.run.stop_on_crash)
         self._last_move = (as_sent(self.home), as_sent(self.home))  # the last step, as sent
@@ -359,7 +360,9 @@ class Vehicle:
         return True
 
 
-def _motion(world: World, home: np.ndarray, wind_rng: np.random.Generator) -> Any:
+def _motion(
+    world: World, home: np.ndarray, wind_rng: np.random.Generator, drift_rng: np.random.Generator
+) -> Any:
     """How the vehicle moves: the kinematic point (the default) or the flying quadrotor in the
     scenario's wind (imported only then: casadi is no small import for a vehicle that does
     not need it)."""
@@ -374,5 +377,6 @@ def _motion(world: World, home: np.ndarray, wind_rng: np.random.Generator) -> An
             scenario.world.wind,
             list(world.structure.boxes),
             wind_rng,
+            drift_rng,
         )
     return Kinematics.at(home)

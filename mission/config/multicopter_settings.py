@@ -76,8 +76,13 @@ class AutopilotSettings:
     acceleration_max_m_s2: float
     tilt_max_deg: float
     rate_max_rad_s: float
+    # between two VISION_POSITION_ESTIMATEs the belief moves by the filter's velocity, the true
+    # one plus a constant bias (drawn once a run) and white noise (drawn each step)
+    velocity_bias_m_s: float  # sigma of the bias, per axis
+    velocity_noise_m_s: float  # sigma of a step's noise, per axis
 
     def __post_init__(self) -> None:
+        _non_negative(self, "velocity_bias_m_s", "velocity_noise_m_s")
         _positive(self, "position_gain_per_s", "velocity_gain_per_s", "attitude_gain_per_s")
         _positive(
             self, "rate_gain_per_s", "acceleration_max_m_s2", "tilt_max_deg", "rate_max_rad_s"

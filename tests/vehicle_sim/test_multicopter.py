@@ -119,3 +119,28 @@ def test_a_hovering_quadrotor_holds_its_place_in_gusts_that_push_it():
     for _ in range(120):
         again.step(STEP_S, 3.0, np.random.default_rng(0), 0.0)
     assert np.array_equal(again.truth, track[-1])  # the same gusts for the same seed
+
+
+def test_between_estimates_the_belief_drifts_as_the_filters_velocity_error_says():
+    """Held still with no estimate for 10 s, the belief's error is bias x T plus a random walk
+    of the per-step noise: across 150 vehicles its spread per axis is
+    sqrt((sigma_b T)^2 + sigma_n^2 dt T)."""
+    from vehicle_sim.closed_loop import ClosedLoop
+
+    loops = VEHICLE.autopilot
+    loop = ClosedLoop(VEHICLE.multicopter, loops, STEP_S)
+    seconds, errors = 10.0, []
+    for seed in range(150):
+        body = Multicopter(loop, np.array([0.0, 12.0, 6.0]), None, np.random.default_rng(seed))
+        body.hold()
+        for _ in range(round(seconds / STEP_S)):
+            body.step(STEP_S, 3.0, np.random.default_rng(0), 0.0)
+        errors.append(body.believed - body.truth)
+    spread = np.std(np.array(errors), axis=0)
+    expected = np.hypot(
+        loops.velocity_bias_m_s * seconds, loops.velocity_noise_m_s * np.sqrt(STEP_S * seconds)
+    )
+    assert spread == pytest.approx(np.full(3, expected), rel=0.2)
+    estimate = Multicopter.at(np.zeros(3) + 6, VEHICLE, STEP_S, drift_rng=np.random.default_rng(1))
+    estimate.set_estimate(estimate.truth)
+    assert estimate.believed == pytest.approx(estimate.truth)  # an estimate resets it
