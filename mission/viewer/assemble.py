@@ -67,7 +67,8 @@ class RunAssembler:
         self.tracks = {n: Track([], []) for n in self.names.values()}
         self.lockstep = False
         self.offsets: dict[int, tuple[int, float]] = {}  # system: (round trip ns, offset s)
-        self._unstamped: dict[int, np.ndarray] = {}  # SIM_STATE awaiting its SYSTEM_TIME
+        self.flying = scenario.vehicle.dynamics == "multicopter"  # SIM_STATE has an attitude
+        self._unstamped: dict[int, tuple] = {}  # SIM_STATE awaiting its SYSTEM_TIME
         self._stamped: list[Stamped] = []  # awaiting the clock offset of their vehicle
         self._fixes: list[tuple[str, float, np.ndarray]] = []  # awaiting the truth
         self._sights: list[tuple[str, float, bool]] = []
@@ -96,10 +97,11 @@ class RunAssembler:
             return
         if kind == "SIM_STATE":
             point = self.frame_of.from_degE7(message.lat_int, message.lon_int, message.alt)
-            self._unstamped[source] = point
+            attitude = (message.q1, message.q2, message.q3, message.q4) if self.flying else None
+            self._unstamped[source] = (point, attitude)
         elif kind == "SYSTEM_TIME" and source in self._unstamped:
-            position = self._unstamped.pop(source)
-            self._stamped.append(Stamped("truth", source, int(message.time_unix_usec), position))
+            truth = self._unstamped.pop(source)
+            self._stamped.append(Stamped("truth", source, int(message.time_unix_usec), truth))
         elif kind == "GPS_RAW_INT" and message.fix_type >= 3:
             point = self.frame_of.from_degE7(message.lat, message.lon, message.alt / 1000.0)
             self._stamped.append(Stamped("fix", source, int(message.time_usec), point))
@@ -125,9 +127,14 @@ class RunAssembler:
             if item.kind == "truth":
                 if t <= self.tracks[name].last:  # a step's telemetry sent again (lockstep)
                     continue
+                position, attitude = item.value
                 self.tracks[name].times.append(t)
-                self.tracks[name].positions.append(item.value)
-                out.points[f.uav_path(name)].add(t, item.value, f.colour_of(name))
+                self.tracks[name].positions.append(position)
+                out.points[f.uav_path(name)].add(t, position, f.colour_of(name))
+                if attitude is not None:
+                    out.strips[f.axes_path(name)].add(
+                        t, body_axes(position, attitude), f.colour_of(name)
+                    )
             elif item.kind == "fix":
                 self._fixes.append((name, t, item.value))
             else:
@@ -182,3 +189,23 @@ def _by_name(items: list[tuple]) -> dict[str, list[tuple]]:
     for item in items:
         grouped.setdefault(item[0], []).append(item)
     return grouped
+
+
+NOSE_M, UP_M = 0.5, 0.8  # the drawn body axes' lengths
+_NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+_FRD_TO_FLU = np.diag([1.0, -1.0, -1.0])
+
+
+def body_axes(position: np.ndarray, quaternion_ned_frd: tuple[float, ...]) -> np.ndarray:
+    """(3, 3): the nose's tip, the centre and the thrust axis' tip (ENU), from SIM_STATE's
+    attitude (body FRD to world NED)."""
+    w, x, y, z = quaternion_ned_frd
+    ned = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    enu = _NED_TO_ENU @ ned @ _FRD_TO_FLU  # body FLU to world ENU
+    return np.vstack([position + NOSE_M * enu[:, 0], position, position + UP_M * enu[:, 2]])

@@ -35,6 +35,7 @@ VISIBLE_COLOUR: Rgb = (224, 224, 224)
 BLOCKED_COLOUR: Rgb = (255, 112, 67)
 BELOW_MARGIN_COLOUR: Rgb = (213, 0, 0)  # two UAVs closer than the separation margin
 WORST_COLOUR: Rgb = (20, 20, 20)  # the worst approach so far
+WIND_COLOUR: Rgb = (64, 160, 255)  # the free stream's arrow
 G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)
 G_CHANGED_M = 0.01  # a voxel is shown once G differs from its initial value by this much
 
@@ -54,6 +55,11 @@ def colour_of(name: str) -> Rgb:
 def uav_path(name: str) -> str:
     """A vehicle's true position (SIM_STATE)."""
     return f"uav/{name}"
+
+
+def axes_path(name: str) -> str:
+    """A flying vehicle's body axes: from the nose's tip through its centre up its thrust axis."""
+    return f"uav/{name}/axes"
 
 
 def estimate_path(name: str) -> str:

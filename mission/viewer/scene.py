@@ -12,6 +12,7 @@ from mission.config.errors import InputError
 from mission.config.settings import Scenario
 from mission.link.plan_files import read_vehicle_waypoints, vehicle_names
 from mission.world.model import World
+from mission.world.wind import WindField
 
 
 @dataclass(frozen=True)
@@ -25,6 +26,7 @@ class Scene:
     waypoints: dict[str, np.ndarray]  # per vehicle, (I, 3); empty where the plan is missing
     voxel_origin: np.ndarray
     voxel_m: float
+    wind: np.ndarray  # the free stream (ENU, m/s); zeros in still air
 
 
 def build_scene(scenario: Scenario, world: World) -> Scene:
@@ -47,4 +49,5 @@ def build_scene(scenario: Scenario, world: World) -> Scene:
         waypoints=waypoints,
         voxel_origin=np.array(grid.origin_m, dtype=float),
         voxel_m=float(grid.voxel_m),
+        wind=WindField(scenario.world.wind, []).free_stream,
     )

@@ -59,6 +59,14 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
         ),
         static=True,
     )
+    if np.any(scene.wind):  # the free stream, from above the workspace's upwind top corner
+        start = np.where(scene.wind >= 0, low, high)[:2]
+        origin = np.array([*start, high[2]])
+        rec.log(
+            "world/wind",
+            rr.Arrows3D(origins=[origin], vectors=[scene.wind], colors=f.WIND_COLOUR, radii=0.1),
+            static=True,
+        )
     for name, points in scene.waypoints.items():
         if len(points):
             colour = f.colour_of(name)

@@ -53,7 +53,10 @@ def test_a_crash_stops_it_dead_and_a_wrong_step_length_is_refused():
 @pytest.mark.slow
 def test_a_run_with_multicopters_flies_its_first_minute(tmp_path):
     scenario = tmp_path / "flying.yaml"
-    scenario.write_text("extends: along\nvehicle: {dynamics: multicopter}\nrun: {timeout_s: 60}\n")
+    scenario.write_text(
+        "extends: along\nvehicle: {dynamics: multicopter}\nrun: {timeout_s: 60}\n"
+        "world: {wind: {speed_m_s: 3.0}}\n"
+    )
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
@@ -73,6 +76,32 @@ def test_a_run_with_multicopters_flies_its_first_minute(tmp_path):
             tilts.append(max(abs(message.roll), abs(message.pitch)))
     assert attitudes >= 4 * 100  # every vehicle, every step
     assert 0.01 < max(tilts) < np.radians(35.5)  # they lean to move, within the tilt limit
+    # the 3-D view draws each body's axes and the wind
+    from tests.viewer.rrd import read_rrd, times
+
+    saved = tmp_path / "run.rrd"
+    assert mission("view", str(tmp_path / "run"), "--save", str(saved)).returncode == 0
+    rows = read_rrd(saved)
+    assert "/world/wind" in rows
+    for name in ("work", "support-1", "support-2", "support-3"):
+        assert len(times(rows[f"/uav/{name}/axes"])) == len(times(rows[f"/uav/{name}"])) > 100
+
+
+def test_the_view_draws_the_axes_of_the_attitude_reported():
+    from mission.viewer.assemble import NOSE_M, UP_M, body_axes
+    from vehicle_sim.rigid_body import rotation
+    from vehicle_sim.telemetry import Attitude
+
+    rng = np.random.default_rng(8)
+    for _ in range(10):
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        position = rng.normal(size=3)
+        nose, centre, up = body_axes(position, Attitude.of(q, np.zeros(3)).quaternion)
+        turned = np.array(rotation(q), dtype=float)  # body FLU to world ENU, the simulation's
+        assert centre == pytest.approx(position)
+        assert nose == pytest.approx(position + NOSE_M * turned[:, 0], abs=1e-9)
+        assert up == pytest.approx(position + UP_M * turned[:, 2], abs=1e-9)
 
 
 def test_the_attitude_is_reported_in_mavlinks_frames():
