@@ -1,1 +1,2 @@
-"""Process helpers: forks, names, CLI errors, atomic writes, the real-time beat. Imports: config."""
+"""Process helpers: forks, names, CLI errors, atomic writes, the real-time beat, casadi's
+compile cache. Imports: config."""

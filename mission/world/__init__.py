@@ -1,1 +1,1 @@
-"""World model: structure, rays, sky, GNSS, camera, frames, grid, zones. Imports: config."""
+"""World model: structure, rays, sky, GNSS, camera, frames, grid, zones, wind. Imports: config."""
