@@ -70,7 +70,8 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     def fake_run(scenario, method, out, mpc_helper=None):
         calls.append((scenario, method, mpc_helper))
         if scenario.endswith("along-multicopter.yaml"):
-            assert "dynamics: multicopter" in Path(scenario).read_text()
+            text = Path(scenario).read_text()
+            assert "dynamics: multicopter" in text and "speed_m_s: 3.0" in text
             return {"realtime_factor": next(flying), "wall_time_s": 12.0}
         if len(calls) <= 6:
             return {"realtime_factor": next(factors), "wall_time_s": 9.0}
