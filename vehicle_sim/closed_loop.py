@@ -16,7 +16,7 @@ import numpy as np
 from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
 from mission.procs.casadi_cache import Compiling, compiled_function
 from vehicle_sim.autopilot_loops import motor_commands
-from vehicle_sim.rigid_body import ATTITUDE, STATE_SIZE, derivative, substeps_of
+from vehicle_sim.rigid_body import STATE_SIZE, runge_kutta_substep, substeps_of
 
 DYNAMICS = Compiling("vehicle", "its flight dynamics", "vehicle_flight")
 FLIGHT_STATE_SIZE = STATE_SIZE + 3
@@ -44,13 +44,8 @@ class ClosedLoop:
         speed = ca.SX.sym("s")
         state, integral = flight[:STATE_SIZE], flight[INTEGRAL]
         command, integral_rate = motor_commands(body, loops, state, integral, target, offset, speed)
-        k1 = derivative(body, state, command, wind)
-        k2 = derivative(body, state + h / 2 * k1, command, wind)
-        k3 = derivative(body, state + h / 2 * k2, command, wind)
-        k4 = derivative(body, state + h * k3, command, wind)
-        after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        q = after[ATTITUDE]
-        after = ca.vertcat(after[:6], q / ca.norm_2(q), after[10:], integral + h * integral_rate)
+        after = runge_kutta_substep(body, state, command, wind, h)
+        after = ca.vertcat(after, integral + h * integral_rate)
         substep = ca.Function("flight", [flight, target, offset, speed, wind], [after])
         folded = substep.fold(self.substeps)
         held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1))]

@@ -74,6 +74,20 @@ def derivative(settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind
     return ca.vertcat(velocity, force / s.mass_kg, spin_rate, angular, lag)
 
 
+def runge_kutta_substep(
+    settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX, h: float
+) -> ca.SX:
+    """The state ``h`` seconds on (a classical Runge-Kutta step, ``command`` and ``wind``
+    held), its attitude renormalised."""
+    k1 = derivative(settings, state, command, wind)
+    k2 = derivative(settings, state + h / 2 * k1, command, wind)
+    k3 = derivative(settings, state + h / 2 * k2, command, wind)
+    k4 = derivative(settings, state + h * k3, command, wind)
+    after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    q = after[ATTITUDE]
+    return ca.vertcat(after[:6], q / ca.norm_2(q), after[10:])
+
+
 def substeps_of(step_s: float, rate_hz: float) -> int:
     """The fewest equal substeps of ``step_s`` at ``rate_hz`` or faster."""
     return max(1, math.ceil(step_s * rate_hz - 1e-9))
@@ -88,13 +102,7 @@ class RigidBody:
         self.substeps = substeps_of(step_s, settings.rate_hz)
         h = step_s / self.substeps
         state, command, wind = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("u", 4), ca.SX.sym("w", 3)
-        k1 = derivative(settings, state, command, wind)
-        k2 = derivative(settings, state + h / 2 * k1, command, wind)
-        k3 = derivative(settings, state + h / 2 * k2, command, wind)
-        k4 = derivative(settings, state + h * k3, command, wind)
-        after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        q = after[ATTITUDE]
-        after = ca.vertcat(after[:6], q / ca.norm_2(q), after[10:])
+        after = runge_kutta_substep(settings, state, command, wind, h)
         self._step = ca.Function("substep", [state, command, wind], [after]).fold(self.substeps)
 
     def advance(self, state: np.ndarray, command: np.ndarray, wind: np.ndarray) -> np.ndarray:
