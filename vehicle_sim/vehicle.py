@@ -13,6 +13,7 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
+from numpy.random import default_rng as rng
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.config.settings import Scenario
@@ -71,16 +72,10 @@ class Vehicle:
         self.frame = GeodeticFrame(scenario.world.anchor)
         self.home = np.asarray(home_enu, dtype=float).reshape(3)
         self.send = send
-        # the fourth child is new: the first three are what they always were
-        # spawned children depend on their index only: the fifth leaves the four as they were
+        # a spawned child depends on its index only: each added one leaves the earlier as they were
         seeds = np.random.SeedSequence([seed, identity.instance]).spawn(6)
-        gnss_seed, camera_seed, motion_seed, failure_seed, wind_seed, drift_seed = seeds
-        self.rng_gnss = np.random.default_rng(gnss_seed)
-        self.rng_camera = np.random.default_rng(camera_seed)
-        self.rng_motion = np.random.default_rng(motion_seed)
-        self.kinematics = _motion(
-            world, self.home, np.random.default_rng(wind_seed), np.random.default_rng(drift_seed)
-        )
+        self.rng_gnss, self.rng_camera, self.rng_motion, _, wind, drift = map(rng, seeds)
+        self.kinematics = _motion(world, self.home, wind, drift)
         detector = ContactDetector(StructureProximity(world.structure), scenario.vehicle.radius_m)
         self.watch = ContactWatch(detector, scenario.run.stop_on_crash)
         self._last_move = (as_sent(self.home), as_sent(self.home))  # the last step, as sent
@@ -111,7 +106,7 @@ class Vehicle:
             del self.intervals_s[mavlink2.MAVLINK_MSG_ID_LANDING_TARGET]
         self._default_intervals = dict(self.intervals_s)
         self._last_sent_s: dict[int, float] = {}
-        self.failures = SensorFailures(failure_seed, vs.sensor_hz)
+        self.failures = SensorFailures(seeds[3], vs.sensor_hz)
         self.on_link_loss: Callable[[float], None] | None = None  # the process's socket, wired in
         self.mission, self.params = self._protocol_servers(speedup, link_loss)
         self.gnss = GnssReceiver(world, self.frame, self.rng_gnss, self.params.table, self.failures)

@@ -1,2 +1,1 @@
-"""Process helpers: forks, names, CLI errors, atomic writes, the real-time beat, casadi's
-compile cache. Imports: config."""
+"""Process helpers: forks, names, CLI errors, atomic writes, beat, casadi cache. Imports: config."""

@@ -59,14 +59,7 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
         ),
         static=True,
     )
-    if np.any(scene.wind):  # the free stream, from above the workspace's upwind top corner
-        start = np.where(scene.wind >= 0, low, high)[:2]
-        origin = np.array([*start, high[2]])
-        rec.log(
-            "world/wind",
-            rr.Arrows3D(origins=[origin], vectors=[scene.wind], colors=f.WIND_COLOUR, radii=0.1),
-            static=True,
-        )
+    _send_wind(rec, scene)
     for name, points in scene.waypoints.items():
         if len(points):
             colour = f.colour_of(name)
@@ -84,6 +77,17 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
                 rec.log(f.scalar_path(kind, name), series, static=True)
     series = rr.SeriesLines(colors=f.WORK_COLOUR, names=_SERIES["work_error"])
     rec.log(f.scalar_path("work_error"), series, static=True)
+
+
+def _send_wind(rec: rr.RecordingStream, scene: Scene) -> None:
+    """The free stream's arrow, from above the workspace's upwind top corner (none in still
+    air)."""
+    if not np.any(scene.wind):
+        return
+    low, high = scene.workspace
+    origin = np.array([*np.where(scene.wind >= 0, low, high)[:2], high[2]])
+    arrow = rr.Arrows3D(origins=[origin], vectors=[scene.wind], colors=f.WIND_COLOUR, radii=0.1)
+    rec.log("world/wind", arrow, static=True)
 
 
 def send_frame(rec: rr.RecordingStream, frame: f.Frame, scene: Scene) -> None:
