@@ -9,7 +9,13 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.world.camera import Observation
-from mission.world.frames import GeodeticFrame, enu_to_ned
+from mission.world.frames import (
+    GeodeticFrame,
+    enu_to_ned,
+    flu_to_frd,
+    quaternion_matrix,
+    swap_attitude_frames,
+)
 from mission.world.gnss import GnssFix
 from vehicle_sim import modes
 
@@ -172,11 +178,6 @@ def global_position_int(
     )
 
 
-# ENU world -> NED world, and FLU body -> FRD body (MAVLink's frames)
-_ENU_TO_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
-_FLU_TO_FRD = np.diag([1.0, -1.0, -1.0])
-
-
 @dataclass(frozen=True)
 class Attitude:
     """An attitude as MAVLink reports it: the quaternion (w, x, y, z) of body FRD to world NED,
@@ -189,15 +190,7 @@ class Attitude:
     @classmethod
     def of(cls, quaternion_enu_flu: np.ndarray, rates_flu: np.ndarray) -> Attitude:
         """From the simulation's frames (body FLU to world ENU, rates in FLU)."""
-        w, x, y, z = (float(v) for v in quaternion_enu_flu)
-        enu = np.array(
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-            ]
-        )
-        r = _ENU_TO_NED @ enu @ _FLU_TO_FRD
+        r = swap_attitude_frames(quaternion_matrix(quaternion_enu_flu))
         roll = math.atan2(r[2, 1], r[2, 2])
         pitch = math.asin(max(-1.0, min(1.0, -r[2, 0])))
         yaw = math.atan2(r[1, 0], r[0, 0])
@@ -217,7 +210,7 @@ class Attitude:
             v[j] = (r[j, i] + r[i, j]) / (4 * v[i])
             v[k] = (r[k, i] + r[i, k]) / (4 * v[i])
             q = ((r[k, j] - r[j, k]) / (4 * v[i]), *v)
-        p, q_rate, r_rate = (float(v) for v in _FLU_TO_FRD @ np.asarray(rates_flu, dtype=float))
+        p, q_rate, r_rate = (float(v) for v in flu_to_frd(rates_flu))
         return cls(tuple(float(v) for v in q), (roll, pitch, yaw), (p, q_rate, r_rate))
 
 

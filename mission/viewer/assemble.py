@@ -22,7 +22,7 @@ from mission.link.plan_files import vehicle_names
 from mission.link.timesync import exchange_offset
 from mission.viewer import frame as f
 from mission.viewer.cycles import CycleRows
-from mission.world.frames import GeodeticFrame
+from mission.world.frames import GeodeticFrame, quaternion_matrix, swap_attitude_frames
 from mission.world.model import World
 
 
@@ -192,20 +192,10 @@ def _by_name(items: list[tuple]) -> dict[str, list[tuple]]:
 
 
 NOSE_M, UP_M = 0.5, 0.8  # the drawn body axes' lengths
-_NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
-_FRD_TO_FLU = np.diag([1.0, -1.0, -1.0])
 
 
 def body_axes(position: np.ndarray, quaternion_ned_frd: tuple[float, ...]) -> np.ndarray:
     """(3, 3): the nose's tip, the centre and the thrust axis' tip (ENU), from SIM_STATE's
     attitude (body FRD to world NED)."""
-    w, x, y, z = quaternion_ned_frd
-    ned = np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-    enu = _NED_TO_ENU @ ned @ _FRD_TO_FLU  # body FLU to world ENU
+    enu = swap_attitude_frames(quaternion_matrix(quaternion_ned_frd))  # body FLU to world ENU
     return np.vstack([position + NOSE_M * enu[:, 0], position, position + UP_M * enu[:, 2]])

@@ -35,6 +35,31 @@ def ned_to_enu(v: np.ndarray) -> np.ndarray:
     return np.asarray(v, dtype=float) @ _SWAP
 
 
+_FLU_FRD = np.diag([1.0, -1.0, -1.0])  # body: forward-left-up <-> forward-right-down
+
+
+def flu_to_frd(v: np.ndarray) -> np.ndarray:
+    """A body vector from FLU (the simulation's) to FRD (MAVLink's); its own inverse."""
+    return _FLU_FRD @ np.asarray(v, dtype=float)
+
+
+def quaternion_matrix(q: np.ndarray) -> np.ndarray:
+    """The rotation matrix of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = (float(v) for v in q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def swap_attitude_frames(rotation: np.ndarray) -> np.ndarray:
+    """A body-to-world rotation from FLU/ENU to FRD/NED, or back: the same product both ways."""
+    return _SWAP @ rotation @ _FLU_FRD
+
+
 def geodetic_to_ecef(lat_deg: float, lon_deg: float, alt_m: float) -> np.ndarray:
     """WGS-84 geodetic -> ECEF (m)."""
     lat, lon = math.radians(lat_deg), math.radians(lon_deg)

@@ -41,15 +41,24 @@ MIN_HEIGHT_FT = 10.0
 MIN_SPEED_M_S = 0.5
 
 
+def blowing_toward(from_deg: float) -> np.ndarray:
+    """The unit vector (ENU) a wind from ``from_deg`` (clockwise from north) blows along."""
+    bearing = math.radians(from_deg)
+    return -np.array([math.sin(bearing), math.cos(bearing), 0.0])
+
+
+def _horizontal_gap(box: BoxPrimitive, x: float, y: float) -> float:
+    """How far (x, y) lies outside a box's footprint (0 inside it)."""
+    (x0, y0, _), (x1, y1, _) = box.min_m, box.max_m
+    return math.hypot(max(x0 - x, 0, x - x1), max(y0 - y, 0, y - y1))
+
+
 class WindField:
     """The mean wind at a point (ENU, m/s) and the factor the structure puts on it."""
 
     def __init__(self, settings: WindSettings, boxes: list[BoxPrimitive]) -> None:
         self.settings = settings
-        bearing = math.radians(settings.from_deg)
-        self.free_stream = -settings.speed_m_s * np.array(
-            [math.sin(bearing), math.cos(bearing), 0.0]
-        )
+        self.free_stream = settings.speed_m_s * blowing_toward(settings.from_deg)
         self.decks = [b for b in boxes if b.min_m[2] > 0]
         self.piers = [b for b in boxes if b.min_m[2] <= 0]
 
@@ -63,17 +72,14 @@ class WindField:
             if inside and z < z0:
                 depth = min(x - x0, x1 - x, y - y0, y1 - y)
                 return s.shelter + (1 - s.shelter) * math.exp(-depth / s.edge_width_m)
-            outside = math.hypot(max(x0 - x, 0, x - x1), max(y0 - y, 0, y - y1))
             if (
                 not inside
-                and outside <= s.edge_width_m
+                and _horizontal_gap(deck, x, y) <= s.edge_width_m
                 and z0 - s.edge_width_m <= z <= z1 + s.edge_width_m
             ):
                 return s.edge_gain
         for pier in self.piers:
-            (x0, y0, _), (x1, y1, z1) = pier.min_m, pier.max_m
-            outside = math.hypot(max(x0 - x, 0, x - x1), max(y0 - y, 0, y - y1))
-            if outside <= s.edge_width_m and z <= z1:
+            if _horizontal_gap(pier, x, y) <= s.edge_width_m and z <= pier.max_m[2]:
                 return s.edge_gain
         return 1.0
 
@@ -127,8 +133,7 @@ class DrydenGusts:
         self.rng = rng
         self.filters = dryden_filters(settings.speed_m_s, height_m, settings.turbulence, dt_s)
         self.state = [np.zeros(max(len(a), len(b)) - 1) for b, a in self.filters]
-        bearing = math.radians(settings.from_deg)
-        along = -np.array([math.sin(bearing), math.cos(bearing), 0.0])
+        along = blowing_toward(settings.from_deg)
         across = np.array([-along[1], along[0], 0.0])
         self.axes = np.column_stack([along, across, [0.0, 0.0, 1.0]])
         # discrete white noise whose spectrum matches the continuous unit one-sided density
