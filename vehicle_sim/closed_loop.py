@@ -5,7 +5,8 @@ classical Runge-Kutta step) and the controller's integral by Euler, as a flight 
 loop runs at a fixed rate. One casadi Function does a whole step, compiled with the system C
 compiler and cached as the support MPC is; the same inputs give the same state bit for bit.
 
-State (20): the body's 17, then the controller's velocity-error integral (3).
+State (20): the body's 17, then the controller's velocity-error integral (3). A step also
+gives the body's position after each substep: the path contact detection follows.
 """
 
 from __future__ import annotations
@@ -16,7 +17,13 @@ import numpy as np
 from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
 from mission.procs.casadi_cache import Compiling, compiled_function
 from vehicle_sim.autopilot_loops import motor_commands
-from vehicle_sim.rigid_body import STATE_SIZE, runge_kutta_substep, substeps_of
+from vehicle_sim.rigid_body import (
+    OPEN_AIR,
+    STATE_SIZE,
+    SURFACES_SIZE,
+    runge_kutta_substep,
+    substeps_of,
+)
 
 DYNAMICS = Compiling("vehicle", "its flight dynamics", "vehicle_flight")
 FLIGHT_STATE_SIZE = STATE_SIZE + 3
@@ -25,7 +32,7 @@ INTEGRAL = slice(STATE_SIZE, FLIGHT_STATE_SIZE)
 
 class ClosedLoop:
     """One step of the flown body: :meth:`advance` (state, target, belief offset, speed limit,
-    wind) -> the state a step later."""
+    wind, surfaces) -> the state a step later and the positions on the way."""
 
     def __init__(
         self,
@@ -41,18 +48,20 @@ class ClosedLoop:
         h = step_s / self.substeps
         flight = ca.SX.sym("x", FLIGHT_STATE_SIZE)
         target, offset, wind = ca.SX.sym("t", 3), ca.SX.sym("d", 3), ca.SX.sym("w", 3)
-        speed = ca.SX.sym("s")
+        speed, surfaces = ca.SX.sym("s"), ca.SX.sym("h", SURFACES_SIZE)
         state, integral = flight[:STATE_SIZE], flight[INTEGRAL]
         command, integral_rate = motor_commands(body, loops, state, integral, target, offset, speed)
-        after = runge_kutta_substep(body, state, command, wind, h)
+        after = runge_kutta_substep(body, state, command, wind, surfaces, h)
         after = ca.vertcat(after, integral + h * integral_rate)
-        substep = ca.Function("flight", [flight, target, offset, speed, wind], [after])
-        folded = substep.fold(self.substeps)
+        inputs = [flight, target, offset, speed, surfaces, wind]
+        substeps = ca.Function("flight", inputs, [after]).mapaccum(self.substeps)
         held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1))]
+        held.append(ca.MX.sym("h", SURFACES_SIZE))
         gusty = ca.MX.sym("w", 3, self.substeps)  # the wind at each substep
         start = ca.MX.sym("x", FLIGHT_STATE_SIZE)
-        final = folded(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
-        step = ca.Function("flight_step", [start, *held, gusty], [final])
+        states = substeps(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
+        final, path = states[:, -1], states[:3, :]
+        step = ca.Function("flight_step", [start, *held, gusty], [final, path])
         self._step = compiled_function(step, DYNAMICS, compiled)
 
     def advance(
@@ -62,10 +71,13 @@ class ClosedLoop:
         belief_offset: np.ndarray,
         speed_limit_m_s: float,
         wind: np.ndarray,
-    ) -> np.ndarray:
-        """The state a step later; ``wind`` (3,) held over the step, or (substeps, 3) one
-        vector a substep."""
+        surfaces: np.ndarray = OPEN_AIR,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(the state a step later, (substeps, 3) the position after each substep); ``wind``
+        (3,) held over the step, or (substeps, 3) one vector a substep; ``surfaces`` the
+        heights above, then below, each rotor (:data:`~vehicle_sim.rigid_body.OPEN_AIR`:
+        none near)."""
         wind = np.asarray(wind, dtype=float)
         winds = np.repeat(wind.reshape(3, 1), self.substeps, axis=1) if wind.ndim == 1 else wind.T
-        final = self._step(state, target, belief_offset, speed_limit_m_s, winds)
-        return np.asarray(final, dtype=float).reshape(FLIGHT_STATE_SIZE)
+        final, path = self._step(state, target, belief_offset, speed_limit_m_s, surfaces, winds)
+        return np.asarray(final, dtype=float).reshape(FLIGHT_STATE_SIZE), np.asarray(path).T

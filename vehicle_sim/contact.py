@@ -1,7 +1,8 @@
 """Contact detection: a vehicle's true body (a sphere of ``vehicle.radius_m``) touching the
 structure, the ground or another vehicle's body.
 
-Each step's motion is a straight segment. Against the structure and the ground it is sampled
+Each step's motion is a path: a point's straight segment, or a flying body's positions at its
+substeps joined by straight legs. Against the structure and the ground it is sampled
 every quarter radius (a body cannot pass through a deck between samples); against another
 vehicle the two straight motions over the same interval give their exact closest approach
 (:func:`~mission.world.proximity.closest_approach`). A contact is a distance below the radius
@@ -45,6 +46,21 @@ def as_sent(position: np.ndarray) -> np.ndarray:
     return ned_to_enu(np.asarray(enu_to_ned(position), dtype=np.float32).astype(float))
 
 
+def dense_path(
+    path: np.ndarray, start_s: float, end_s: float, spacing_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``path``'s points at equal times from ``start_s`` to ``end_s``, with points added along
+    each leg so that none is more than ``spacing_m`` from the next, and their times."""
+    legs = np.diff(path, axis=0)
+    cuts = np.maximum(np.ceil(np.linalg.norm(legs, axis=1) / spacing_m), 1).astype(int)
+    leg = np.repeat(np.arange(len(legs)), cuts)
+    fraction = (np.arange(len(leg)) - np.repeat(np.cumsum(cuts) - cuts, cuts)) / cuts[leg]
+    joints = np.linspace(start_s, end_s, len(path))
+    points = np.vstack([path[leg] + fraction[:, None] * legs[leg], path[-1:]])
+    times = np.append(joints[leg] + fraction * (joints[leg + 1] - joints[leg]), end_s)
+    return points, times
+
+
 class ContactDetector:
     """One vehicle's contact checks, with its radius and the structure's proximity."""
 
@@ -57,8 +73,18 @@ class ContactDetector:
     ) -> list[Contact]:
         """The first contact with the structure and the first with the ground along a step from
         ``start`` to ``end``."""
-        points = segment_points(start, end, self.radius_m / 4)
-        times = np.linspace(start_s, end_s, len(points))
+        return self.along(np.vstack([start, end]), start_s, end_s)
+
+    def along(self, path: np.ndarray, start_s: float, end_s: float) -> list[Contact]:
+        """The first contact with the structure and the first with the ground along ``path``
+        ((n, 3) positions at equal times from ``start_s`` to ``end_s``: a flying body's
+        substeps, or a point's two ends)."""
+        path = np.asarray(path, dtype=float)
+        if len(path) == 2:
+            points = segment_points(path[0], path[1], self.radius_m / 4)
+            times = np.linspace(start_s, end_s, len(points))
+        else:
+            points, times = dense_path(path, start_s, end_s, self.radius_m / 4)
         found = []
         for other, gaps in (
             (STRUCTURE, self.proximity.distance(points)),

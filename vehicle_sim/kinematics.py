@@ -16,6 +16,7 @@ class Kinematics:
     believed: np.ndarray
     target: np.ndarray | None = None
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    path: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # the last step's ends
 
     @classmethod
     def at(cls, home: np.ndarray) -> Kinematics:
@@ -49,7 +50,9 @@ class Kinematics:
             reach = speed_limit_m_s * dt_s
             move = wanted if distance <= reach else wanted * (reach / distance)
         self.believed = self.believed + move
+        start = self.truth
         error = rng.normal(0.0, noise_m, 3) if noise_m > 0 else np.zeros(3)
         self.truth = self.truth + move + error
         self.velocity = (move + error) / dt_s
+        self.path = np.vstack([start, self.truth])
         return move

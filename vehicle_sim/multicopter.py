@@ -9,7 +9,8 @@ between estimates the belief follows the vehicle by its navigation filter's velo
 one plus a bias (per run and axis) and noise (per step): the offset drifts.
 ``vehicle.tracking_noise_m`` still kicks the true position each step, as in the kinematic
 model. The wind (:mod:`mission.world.wind`) is sampled at the vehicle's true position at the
-start of each step, one vector a substep.
+start of each step, one vector a substep; so are the surfaces above and below each rotor (the
+ceiling and ground effects: :mod:`mission.world.surfaces`), held over the step.
 """
 
 from __future__ import annotations
@@ -19,9 +20,19 @@ import numpy as np
 from mission.config.planner_vehicle_settings import VehicleSettings
 from mission.config.settings import BoxPrimitive
 from mission.config.wind_settings import WindSettings
+from mission.world.frames import quaternion_matrix
+from mission.world.surfaces import VerticalSurfaces
 from mission.world.wind import VehicleWind
 from vehicle_sim.closed_loop import ClosedLoop
-from vehicle_sim.rigid_body import ATTITUDE, POSITION, RATES, VELOCITY, resting_state
+from vehicle_sim.rigid_body import (
+    ATTITUDE,
+    OPEN_AIR,
+    POSITION,
+    RATES,
+    VELOCITY,
+    resting_state,
+    rotor_offsets,
+)
 
 CALM = np.zeros(3)
 
@@ -35,9 +46,13 @@ class Multicopter:
         home: np.ndarray,
         wind: VehicleWind | None = None,
         drift_rng: np.random.Generator | None = None,
+        surfaces: VerticalSurfaces | None = None,
     ) -> None:
         self.loop = loop
         self.wind = wind  # None: still air
+        # None, or no proximity effect in the body: nothing near changes the thrust
+        self.surfaces = surfaces if loop.body.proximity_effects else None
+        self.rotors = rotor_offsets(loop.body)
         loops = loop.loops
         self.drift_rng = drift_rng  # None: the belief moves with the truth exactly
         self.velocity_bias = (
@@ -46,6 +61,7 @@ class Multicopter:
         self.state = np.concatenate([resting_state(home, loop.body), np.zeros(3)])
         self.offset = np.zeros(3)  # believed - true position
         self.target: np.ndarray | None = None
+        self.path = self.state[POSITION][None].copy()  # true positions over the last step
 
     @classmethod
     def at(
@@ -57,18 +73,20 @@ class Multicopter:
         boxes: list[BoxPrimitive] | None = None,
         rng: np.random.Generator | None = None,
         drift_rng: np.random.Generator | None = None,
+        surfaces: VerticalSurfaces | None = None,
     ) -> Multicopter:
         """A quadrotor hovering at ``home`` that knows where it is, in ``wind`` around the
         structure's ``boxes`` (its gusts drawn from ``rng``), or in still air; its belief
         drifting between estimates by the filter's velocity error (drawn from ``drift_rng``),
-        or not at all."""
+        or not at all; its rotors' thrust changed by the ``surfaces`` near them, or by
+        none."""
         loop = ClosedLoop(vehicle.multicopter, vehicle.autopilot, step_s)
         home = np.asarray(home, dtype=float).reshape(3)
         weather = None
         if wind is not None and rng is not None:
             dt = step_s / loop.substeps
             weather = VehicleWind.of(wind, boxes or [], float(home[2]), dt, rng)
-        return cls(loop, home, weather, drift_rng)
+        return cls(loop, home, weather, drift_rng, surfaces)
 
     def set_wind(self, settings: WindSettings) -> None:
         """The wind from now on: the same as before, or a new one (its gusts start afresh from
@@ -104,6 +122,13 @@ class Multicopter:
         """Its body rates (FLU, rad/s)."""
         return self.state[RATES].copy()
 
+    def _surfaces_near(self) -> np.ndarray:
+        """The heights of the surfaces above, then below, each rotor now."""
+        if self.surfaces is None:
+            return OPEN_AIR
+        rotors = self.state[POSITION] + self.rotors @ quaternion_matrix(self.attitude).T
+        return np.concatenate([self.surfaces.above(rotors), self.surfaces.below(rotors)])
+
     def set_estimate(self, estimate: np.ndarray) -> None:
         """The navigation estimate streamed by the ground station replaces the belief."""
         self.offset = np.asarray(estimate, dtype=float).reshape(3) - self.state[POSITION]
@@ -130,7 +155,10 @@ class Multicopter:
         before = self.believed
         target = before if self.target is None else self.target
         wind = CALM if self.wind is None else self.wind.over_step(self.truth, self.loop.substeps)
-        self.state = self.loop.advance(self.state, target, self.offset, speed_limit_m_s, wind)
+        start = self.truth
+        self.state, path = self.loop.advance(
+            self.state, target, self.offset, speed_limit_m_s, wind, self._surfaces_near()
+        )
         if self.drift_rng is not None:  # the filter's velocity error, integrated over the step
             noise = self.drift_rng.normal(0.0, self.loop.loops.velocity_noise_m_s, 3)
             self.offset = self.offset + (self.velocity_bias + noise) * dt_s
@@ -138,4 +166,5 @@ class Multicopter:
             kick = rng.normal(0.0, noise_m, 3)
             self.state[POSITION] += kick
             self.offset = self.offset - kick
+        self.path = np.vstack([start, path[:-1], self.truth])
         return self.believed - before

@@ -8,9 +8,16 @@ the rotors' arms and their reaction torques, linear body drag against the air's 
 FLU body (x nose, y left, z up); the attitude is the unit quaternion (w, x, y, z) taking body
 to world.
 
+Near a surface each rotor's thrust is multiplied by the ceiling or ground effect's gain
+(:class:`~mission.config.multicopter_settings.MulticopterSettings`) for its own distance to the
+surface above or below it (the rotors lie in the body's x-y plane through its centre): a body
+tilted under a deck makes more thrust on its upper side, and a moment. The rotors' reaction
+torque stays as commanded (the law holds the rotor's power: its torque does not change).
+
 State (17): position (3, m), velocity (3, m/s), attitude (4), body rates (3, rad/s), rotor
-thrusts (4, N). Inputs over a step: the rotors' commands (4, 0..1) and the wind (3, m/s, world),
-both held over each substep. A step of ``step_s`` is cut into the fewest equal substeps at
+thrusts (4, N, away from surfaces). Inputs over a step: the rotors' commands (4, 0..1), the
+wind (3, m/s, world) and the heights of the surfaces above and below each rotor (8, m), held
+over each substep. A step of ``step_s`` is cut into the fewest equal substeps at
 ``rate_hz`` or faster, each a classical Runge-Kutta step with the attitude renormalised after
 it, so the same state and inputs give the same result bit for bit.
 """
@@ -36,6 +43,8 @@ POSITION, VELOCITY, ATTITUDE, RATES, THRUSTS = (
 # (PX4's quad X: front-right and rear-left counter-clockwise)
 ROTOR_ANGLES_DEG = (45.0, 135.0, 225.0, 315.0)
 ROTOR_SPINS = (-1.0, 1.0, -1.0, 1.0)
+SURFACES_SIZE = 8  # the heights of the surface above each rotor, then below each
+OPEN_AIR = np.array([1.0e6] * 4 + [-1.0e6] * 4)  # nothing near: no gain worth the name
 
 
 def rotation(q: ca.SX) -> ca.SX:
@@ -48,20 +57,53 @@ def rotation(q: ca.SX) -> ca.SX:
     )
 
 
-def derivative(settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX):
+def rotor_offsets(settings: MulticopterSettings) -> np.ndarray:
+    """(4, 3): each rotor's centre in the body frame (FLU, m)."""
+    angles = np.radians(ROTOR_ANGLES_DEG)
+    return settings.arm_m * np.column_stack([np.cos(angles), np.sin(angles), np.zeros(4)])
+
+
+def proximity_gain(k: float, radius_m: float, clip_radii: float, distance_m):
+    """A rotor's thrust gain ``distance_m`` from a surface: 1 / (1 - k (R/d)^2), d held at
+    ``clip_radii`` rotor radii closer in (casadi or numpy)."""
+    held = ca.fmax(distance_m, clip_radii * radius_m)
+    return 1 / (1 - k * (radius_m / held) ** 2)
+
+
+def near_surfaces(settings: MulticopterSettings, state: ca.SX, surfaces: ca.SX) -> ca.SX:
+    """(4,) each rotor's thrust gain under the surface above it and over the one below
+    (``surfaces``: the four rotors' heights above, then below)."""
+    s = settings
+    heights = state[2] + (rotation(state[ATTITUDE]) @ ca.DM(rotor_offsets(s).T))[2, :].T
+    gain = ca.DM.ones(4)
+    for k, gap in (
+        (s.ceiling_effect_k, surfaces[:4] - heights),
+        (s.ground_effect_k, heights - surfaces[4:]),
+    ):
+        if k > 0:
+            gain = gain * proximity_gain(k, s.rotor_radius_m, s.proximity_clip_radii, gap)
+    return gain
+
+
+def derivative(
+    settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX, surfaces: ca.SX
+):
     """d(state)/dt of the rigid body under the rotors' ``command`` (clipped to 0..1)."""
     s = settings
     velocity, q, rates, thrusts = (state[part] for part in (VELOCITY, ATTITUDE, RATES, THRUSTS))
+    lifting = thrusts * near_surfaces(s, state, surfaces) if s.proximity_effects else thrusts
     inertia = ca.DM(np.diag(s.inertia_kg_m2))
-    force = rotation(q) @ ca.vertcat(0, 0, ca.sum1(thrusts))
+    force = rotation(q) @ ca.vertcat(0, 0, ca.sum1(lifting))
     force += -s.drag_n_per_m_s * (velocity - wind) - ca.vertcat(0, 0, s.mass_kg * STANDARD_GRAVITY)
     torque_per_thrust = s.rotor_torque_max_n_m / s.rotor_thrust_max_n
     moment = -s.rotational_damping_n_m_per_rad_s * rates
-    for angle, spin, thrust in zip(ROTOR_ANGLES_DEG, ROTOR_SPINS, ca.vertsplit(thrusts)):
+    for angle, spin, lift, thrust in zip(
+        ROTOR_ANGLES_DEG, ROTOR_SPINS, ca.vertsplit(lifting), ca.vertsplit(thrusts)
+    ):
         arm_x = s.arm_m * math.cos(math.radians(angle))
         arm_y = s.arm_m * math.sin(math.radians(angle))
         # the arm's moment (r x F for F along body z) and the reaction to the rotor's spin
-        moment += ca.vertcat(arm_y * thrust, -arm_x * thrust, -spin * torque_per_thrust * thrust)
+        moment += ca.vertcat(arm_y * lift, -arm_x * lift, -spin * torque_per_thrust * thrust)
     angular = ca.solve(inertia, moment - ca.cross(rates, inertia @ rates))
     spin_rate = 0.5 * ca.vertcat(
         -q[1] * rates[0] - q[2] * rates[1] - q[3] * rates[2],
@@ -75,14 +117,20 @@ def derivative(settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind
 
 
 def runge_kutta_substep(
-    settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX, h: float
+    settings: MulticopterSettings,
+    state: ca.SX,
+    command: ca.SX,
+    wind: ca.SX,
+    surfaces: ca.SX,
+    h: float,
 ) -> ca.SX:
-    """The state ``h`` seconds on (a classical Runge-Kutta step, ``command`` and ``wind``
-    held), its attitude renormalised."""
-    k1 = derivative(settings, state, command, wind)
-    k2 = derivative(settings, state + h / 2 * k1, command, wind)
-    k3 = derivative(settings, state + h / 2 * k2, command, wind)
-    k4 = derivative(settings, state + h * k3, command, wind)
+    """The state ``h`` seconds on (a classical Runge-Kutta step, ``command``, ``wind`` and
+    ``surfaces`` held), its attitude renormalised."""
+    held = (command, wind, surfaces)
+    k1 = derivative(settings, state, *held)
+    k2 = derivative(settings, state + h / 2 * k1, *held)
+    k3 = derivative(settings, state + h / 2 * k2, *held)
+    k4 = derivative(settings, state + h * k3, *held)
     after = state + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     q = after[ATTITUDE]
     return ca.vertcat(after[:6], q / ca.norm_2(q), after[10:])
@@ -102,16 +150,25 @@ class RigidBody:
         self.substeps = substeps_of(step_s, settings.rate_hz)
         h = step_s / self.substeps
         state, command, wind = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("u", 4), ca.SX.sym("w", 3)
-        after = runge_kutta_substep(settings, state, command, wind, h)
-        self._step = ca.Function("substep", [state, command, wind], [after]).fold(self.substeps)
+        surfaces = ca.SX.sym("h", SURFACES_SIZE)
+        after = runge_kutta_substep(settings, state, command, wind, surfaces, h)
+        substep = ca.Function("substep", [state, command, wind, surfaces], [after])
+        self._step = substep.fold(self.substeps)
 
-    def advance(self, state: np.ndarray, command: np.ndarray, wind: np.ndarray) -> np.ndarray:
-        """The state one step later, ``command`` and ``wind`` held over it."""
+    def advance(
+        self,
+        state: np.ndarray,
+        command: np.ndarray,
+        wind: np.ndarray,
+        surfaces: np.ndarray = OPEN_AIR,
+    ) -> np.ndarray:
+        """The state one step later, ``command``, ``wind`` and ``surfaces`` (the heights
+        above, then below, each rotor: :data:`OPEN_AIR` by default) held over it."""
         count = self.substeps
+        held = [(command, 4), (wind, 3), (surfaces, SURFACES_SIZE)]
         result = self._step(
             np.asarray(state, dtype=float),
-            np.repeat(np.asarray(command, dtype=float).reshape(4, 1), count, axis=1),
-            np.repeat(np.asarray(wind, dtype=float).reshape(3, 1), count, axis=1),
+            *(np.repeat(np.asarray(v, dtype=float).reshape(n, 1), count, axis=1) for v, n in held),
         )
         return np.asarray(result, dtype=float).reshape(STATE_SIZE)
 

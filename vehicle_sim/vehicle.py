@@ -263,9 +263,7 @@ class Vehicle:
         self.steps += 1
         self.sim_time_s = self.steps * self.step_s
         if self.armed:
-            found = self.watch.detector.with_surroundings(
-                start, self.kinematics.truth, start_s, self.sim_time_s
-            )
+            found = self.watch.detector.along(self.kinematics.path, start_s, self.sim_time_s)
             self._report(self.watch.new_contacts("surroundings", found))
         self._last_move = (as_sent(start), as_sent(self.kinematics.truth))
         if len(self.faults):
@@ -363,6 +361,7 @@ def _motion(
     not need it)."""
     scenario = world.scenario
     if scenario.vehicle.dynamics == "multicopter":
+        from mission.world.surfaces import VerticalSurfaces
         from vehicle_sim.multicopter import Multicopter
 
         return Multicopter.at(
@@ -373,5 +372,6 @@ def _motion(
             list(world.structure.boxes),
             wind_rng,
             drift_rng,
+            VerticalSurfaces(world.structure),
         )
     return Kinematics.at(home)

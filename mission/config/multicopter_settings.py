@@ -6,11 +6,19 @@ quadrotor (``src/modules/simulation/simulator_sih/sih_params.yaml``: SIH_MASS 1.
 SIH_IXX/IYY 0.025 and SIH_IZZ 0.03 kg m^2, SIH_T_MAX 5 N and SIH_Q_MAX 0.1 N m per rotor,
 SIH_L_ROLL 0.2 m, SIH_KDV 1.0 N/(m/s), SIH_KDW 0.025 N m/(rad/s), SIH_T_TAU 0.05 s): mass,
 inertia, rotor thrust and torque x 1.5 (the same frame, heavier: thrust-to-weight stays ~2),
-arm, drag and motor lag as SIH has them.
+arm, drag and motor lag as SIH has them. SIH has no propellers' size: the rotor radius is a
+10-inch propeller's, the size a 450-class frame with 0.2 m arms carries.
+
+Near a surface a rotor makes more thrust for the same power: the ground effect below
+(Cheeseman and Bennett 1955: T/T0 = 1 / (1 - (R / 4z)^2), R the rotor radius, z the height)
+and, by the same image argument, the ceiling effect under a deck (docs/model.md). Both are
+T/T0 = 1 / (1 - k (R / d)^2) with d the distance from the rotor to the surface and k = 1/16,
+held at its value at ``proximity_clip_radii`` closer in (the law diverges at d = R sqrt(k)).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from mission.config.checks import non_negative as _non_negative
@@ -35,9 +43,15 @@ class MulticopterSettings:
     drag_n_per_m_s: float  # body drag -k (v - wind), as SIH's KDV
     rotational_damping_n_m_per_rad_s: float  # -k omega, as SIH's KDW
     rate_hz: float  # fixed integration rate within each step
+    rotor_radius_m: float
+    ceiling_effect_k: float  # T/T0 = 1 / (1 - k (R/d)^2) under a surface (0: none)
+    ground_effect_k: float  # ... above one
+    proximity_clip_radii: float  # closer than this (rotor radii) the gain stays as it is there
 
     def __post_init__(self) -> None:
         _positive(self, "mass_kg", "arm_m", "rotor_thrust_max_n", "motor_tau_s", "rate_hz")
+        _positive(self, "rotor_radius_m", "proximity_clip_radii")
+        _non_negative(self, "ceiling_effect_k", "ground_effect_k")
         _non_negative(self, "rotor_torque_max_n_m", "drag_n_per_m_s")
         _non_negative(self, "rotational_damping_n_m_per_rad_s")
         _require(len(self.inertia_kg_m2) == 3, "inertia_kg_m2", "must be [Ixx, Iyy, Izz]")
@@ -59,6 +73,24 @@ class MulticopterSettings:
             "rotor_thrust_max_n",
             f"must exceed a quarter of the weight ({hover:.2f} N): it could not hover",
         )
+        spacing = self.arm_m * math.sqrt(2)  # between neighbouring rotors of an X
+        _require(
+            2 * self.rotor_radius_m <= spacing,
+            "rotor_radius_m",
+            f"neighbouring rotors {spacing:.3f} m apart would overlap",
+        )
+        for name in ("ceiling_effect_k", "ground_effect_k"):
+            _require(
+                getattr(self, name) < self.proximity_clip_radii**2,
+                name,
+                f"must be below proximity_clip_radii^2 ({self.proximity_clip_radii**2:g}): "
+                "the thrust gain would be infinite within the clip distance",
+            )
+
+    @property
+    def proximity_effects(self) -> bool:
+        """Whether a surface above or below changes the rotors' thrust."""
+        return self.ceiling_effect_k > 0 or self.ground_effect_k > 0
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ def _start(position) -> np.ndarray:
 def _fly(loop, state, target, seconds, speed=3.0, wind=CALM, offset=NO_OFFSET):
     track = []
     for _ in range(round(seconds / TICK_S)):
-        state = loop.advance(state, np.asarray(target, dtype=float), offset, speed, wind)
+        state, _ = loop.advance(state, np.asarray(target, dtype=float), offset, speed, wind)
         track.append(state.copy())
     return state, np.array(track)
 
@@ -104,6 +104,7 @@ def test_compiled_and_interpreted_fly_the_same_bit_for_bit(loop):
     start, target = _start([0.0, 0.0, 10.0]), np.array([2.0, -1.0, 11.0])
     a = b = start
     for _ in range(25):
-        a = loop.advance(a, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
-        b = interpreted.advance(b, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
+        a, path_a = loop.advance(a, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
+        b, path_b = interpreted.advance(b, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
     assert np.array_equal(a, b) and not np.array_equal(a, start)
+    assert np.array_equal(path_a, path_b) and np.array_equal(path_a[-1], a[:3])

@@ -1,0 +1,71 @@
+"""The surfaces straight above and below points: the deck's underside a rotor flies under, the
+ground or a pier's top it flies over (the ceiling and ground effects of a flying vehicle,
+:mod:`vehicle_sim.rigid_body`).
+
+Box primitives answer in closed form (a box is above a point when the point's x and y lie within
+its footprint and its underside is not below the point); a mesh file answers by casting a ray
+up and one down from each point (trimesh's ray tracer: a world with a mesh file imports trimesh
+anyway). The ground is the plane z = 0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mission.world.proximity import BOX_FACES
+from mission.world.structure import Structure
+
+NONE_ABOVE_M = 1.0e6  # the height reported where nothing is above
+
+
+class VerticalSurfaces:
+    """Heights of the nearest surface above and below points, for one structure."""
+
+    def __init__(self, structure: Structure) -> None:
+        boxes = structure.boxes
+        self.low = np.array([b.min_m for b in boxes], dtype=float).reshape(-1, 3)
+        self.high = np.array([b.max_m for b in boxes], dtype=float).reshape(-1, 3)
+        extra = structure.faces[BOX_FACES * len(boxes) :]
+        self._rays = None
+        if len(extra):
+            import trimesh
+
+            mesh = trimesh.Trimesh(structure.vertices, extra, process=False)
+            self._rays = trimesh.ray.ray_triangle.RayMeshIntersector(mesh)
+
+    def _footprint(self, points: np.ndarray) -> np.ndarray:
+        """(points, boxes): whether each point's x and y lie within each box's footprint."""
+        xy = points[:, None, :2]
+        return np.all((xy >= self.low[None, :, :2]) & (xy <= self.high[None, :, :2]), axis=2)
+
+    def above(self, points: np.ndarray) -> np.ndarray:
+        """(n,) the height of the nearest surface above each point (``NONE_ABOVE_M`` where the
+        sky is open)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        over = self._footprint(points) & (self.low[None, :, 2] >= points[:, 2:3])
+        heights = np.where(over, self.low[None, :, 2], NONE_ABOVE_M).min(
+            axis=1, initial=NONE_ABOVE_M
+        )
+        if self._rays is not None:
+            heights = np.minimum(heights, self._ray_heights(points, 1.0, NONE_ABOVE_M))
+        return heights
+
+    def below(self, points: np.ndarray) -> np.ndarray:
+        """(n,) the height of the nearest surface below each point (the ground at least)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        under = self._footprint(points) & (self.high[None, :, 2] <= points[:, 2:3])
+        heights = np.where(under, self.high[None, :, 2], 0.0).max(axis=1, initial=0.0)
+        if self._rays is not None:
+            heights = np.maximum(heights, self._ray_heights(points, -1.0, 0.0))
+        return heights
+
+    def _ray_heights(self, points: np.ndarray, up: float, none: float) -> np.ndarray:
+        """The height where a vertical ray from each point (``up`` +1 or -1) first meets the
+        mesh file, ``none`` where it meets nothing."""
+        directions = np.tile([0.0, 0.0, up], (len(points), 1))
+        found = np.full(len(points), none)
+        locations, ray_ids, _ = self._rays.intersects_location(points, directions)
+        for ray, height in zip(ray_ids, locations[:, 2]):
+            nearer = height < found[ray] if up > 0 else height > found[ray]
+            found[ray] = height if nearer else found[ray]
+        return found
