@@ -6,7 +6,7 @@ loop runs at a fixed rate. One casadi Function does a whole step, compiled with 
 compiler and cached as the support MPC is; the same inputs give the same state bit for bit.
 
 State (20): the body's 17, then the controller's velocity-error integral (3). A step also
-gives the body's position after each substep: the path contact detection follows.
+gives the body's position after every few substeps: the path contact detection follows.
 """
 
 from __future__ import annotations
@@ -28,6 +28,14 @@ from vehicle_sim.rigid_body import (
 DYNAMICS = Compiling("vehicle", "its flight dynamics", "vehicle_flight")
 FLIGHT_STATE_SIZE = STATE_SIZE + 3
 INTEGRAL = slice(STATE_SIZE, FLIGHT_STATE_SIZE)
+PATH_INTERVAL_S = 0.02  # the path's points at most this far apart in time (3 cm at 1.5 m/s)
+
+
+def path_stride(substeps: int, h: float) -> int:
+    """The most substeps between two of the path's points: a divisor of ``substeps`` at most
+    :data:`PATH_INTERVAL_S` long (1: every substep)."""
+    fitting = [n for n in range(1, substeps + 1) if substeps % n == 0 and n * h <= PATH_INTERVAL_S]
+    return max(fitting, default=1)
 
 
 class ClosedLoop:
@@ -54,12 +62,16 @@ class ClosedLoop:
         after = runge_kutta_substep(body, state, command, wind, surfaces, h)
         after = ca.vertcat(after, integral + h * integral_rate)
         inputs = [flight, target, offset, speed, surfaces, wind]
-        substeps = ca.Function("flight", inputs, [after]).mapaccum(self.substeps)
+        substep = ca.Function("flight", inputs, [after])
+        # the state after every few substeps (at most PATH_INTERVAL_S apart): the path
+        stride = path_stride(self.substeps, h)
+        stretch = substep.fold(stride) if stride > 1 else substep
+        stretches = stretch.mapaccum(self.substeps // stride)
         held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1))]
         held.append(ca.MX.sym("h", SURFACES_SIZE))
         gusty = ca.MX.sym("w", 3, self.substeps)  # the wind at each substep
         start = ca.MX.sym("x", FLIGHT_STATE_SIZE)
-        states = substeps(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
+        states = stretches(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
         final, path = states[:, -1], states[:3, :]
         step = ca.Function("flight_step", [start, *held, gusty], [final, path])
         self._step = compiled_function(step, DYNAMICS, compiled)
@@ -73,7 +85,8 @@ class ClosedLoop:
         wind: np.ndarray,
         surfaces: np.ndarray = OPEN_AIR,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(the state a step later, (substeps, 3) the position after each substep); ``wind``
+        """(the state a step later, (n, 3) the position after every few substeps, the last one
+        the step's end: :func:`path_stride`); ``wind``
         (3,) held over the step, or (substeps, 3) one vector a substep; ``surfaces`` the
         heights above, then below, each rotor (:data:`~vehicle_sim.rigid_body.OPEN_AIR`:
         none near)."""

@@ -18,6 +18,7 @@ import numpy as np
 from mission.world.frames import enu_to_ned, ned_to_enu
 from mission.world.proximity import StructureProximity, closest_approach, segment_points
 
+CLEAR_SLACK_M = 1e-6  # rounding's share in the shortcut of a path clear of everything
 STRUCTURE = "structure"
 GROUND = "ground"
 
@@ -80,6 +81,13 @@ class ContactDetector:
         ((n, 3) positions at equal times from ``start_s`` to ``end_s``: a flying body's
         substeps, or a point's two ends)."""
         path = np.asarray(path, dtype=float)
+        # no point of the path is further from its start than this: where the start is more
+        # than this and a radius from the structure and the ground, no point touches them
+        # (a distance changes no faster than the point moves)
+        reach = float(np.sqrt(np.max(np.sum((path - path[0]) ** 2, axis=1))))
+        clear = self.radius_m + reach + CLEAR_SLACK_M
+        if path[0, 2] > clear and self.proximity.distance(path[:1])[0] > clear:
+            return []
         if len(path) == 2:
             points = segment_points(path[0], path[1], self.radius_m / 4)
             times = np.linspace(start_s, end_s, len(points))

@@ -127,7 +127,7 @@ class Multicopter:
         if self.surfaces is None:
             return OPEN_AIR
         rotors = self.state[POSITION] + self.rotors @ quaternion_matrix(self.attitude).T
-        return np.concatenate([self.surfaces.above(rotors), self.surfaces.below(rotors)])
+        return np.concatenate(self.surfaces.heights(rotors))
 
     def set_estimate(self, estimate: np.ndarray) -> None:
         """The navigation estimate streamed by the ground station replaces the belief."""

@@ -17,9 +17,10 @@ torque stays as commanded (the law holds the rotor's power: its torque does not 
 State (17): position (3, m), velocity (3, m/s), attitude (4), body rates (3, rad/s), rotor
 thrusts (4, N, away from surfaces). Inputs over a step: the rotors' commands (4, 0..1), the
 wind (3, m/s, world) and the heights of the surfaces above and below each rotor (8, m), held
-over each substep. A step of ``step_s`` is cut into the fewest equal substeps at
-``rate_hz`` or faster, each a classical Runge-Kutta step with the attitude renormalised after
-it, so the same state and inputs give the same result bit for bit.
+over each substep; so are the gains, from the rotors' heights as the substep starts. A step
+of ``step_s`` is cut into the fewest equal substeps at ``rate_hz`` or faster, each a classical
+Runge-Kutta step with the attitude renormalised after it, so the same state and inputs give
+the same result bit for bit.
 """
 
 from __future__ import annotations
@@ -86,12 +87,13 @@ def near_surfaces(settings: MulticopterSettings, state: ca.SX, surfaces: ca.SX) 
 
 
 def derivative(
-    settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX, surfaces: ca.SX
+    settings: MulticopterSettings, state: ca.SX, command: ca.SX, wind: ca.SX, gains: ca.SX | None
 ):
-    """d(state)/dt of the rigid body under the rotors' ``command`` (clipped to 0..1)."""
+    """d(state)/dt of the rigid body under the rotors' ``command`` (clipped to 0..1), each
+    rotor's thrust times its ``gains`` near surfaces (None: away from any)."""
     s = settings
     velocity, q, rates, thrusts = (state[part] for part in (VELOCITY, ATTITUDE, RATES, THRUSTS))
-    lifting = thrusts * near_surfaces(s, state, surfaces) if s.proximity_effects else thrusts
+    lifting = thrusts if gains is None else thrusts * gains
     inertia = ca.DM(np.diag(s.inertia_kg_m2))
     force = rotation(q) @ ca.vertcat(0, 0, ca.sum1(lifting))
     force += -s.drag_n_per_m_s * (velocity - wind) - ca.vertcat(0, 0, s.mass_kg * STANDARD_GRAVITY)
@@ -124,9 +126,11 @@ def runge_kutta_substep(
     surfaces: ca.SX,
     h: float,
 ) -> ca.SX:
-    """The state ``h`` seconds on (a classical Runge-Kutta step, ``command``, ``wind`` and
-    ``surfaces`` held), its attitude renormalised."""
-    held = (command, wind, surfaces)
+    """The state ``h`` seconds on (a classical Runge-Kutta step, ``command``, ``wind`` and the
+    rotors' gains near the ``surfaces`` as the substep starts held), its attitude
+    renormalised."""
+    gains = near_surfaces(settings, state, surfaces) if settings.proximity_effects else None
+    held = (command, wind, gains)
     k1 = derivative(settings, state, *held)
     k2 = derivative(settings, state + h / 2 * k1, *held)
     k3 = derivative(settings, state + h / 2 * k2, *held)

@@ -38,26 +38,20 @@ class VerticalSurfaces:
         xy = points[:, None, :2]
         return np.all((xy >= self.low[None, :, :2]) & (xy <= self.high[None, :, :2]), axis=2)
 
-    def above(self, points: np.ndarray) -> np.ndarray:
-        """(n,) the height of the nearest surface above each point (``NONE_ABOVE_M`` where the
-        sky is open)."""
+    def heights(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((n,), (n,)): the height of the nearest surface above each point
+        (``NONE_ABOVE_M`` where the sky is open) and below it (the ground at least)."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
-        over = self._footprint(points) & (self.low[None, :, 2] >= points[:, 2:3])
-        heights = np.where(over, self.low[None, :, 2], NONE_ABOVE_M).min(
-            axis=1, initial=NONE_ABOVE_M
-        )
+        inside = self._footprint(points)
+        z = points[:, 2:3]
+        over = inside & (self.low[None, :, 2] >= z)
+        under = inside & (self.high[None, :, 2] <= z)
+        above = np.where(over, self.low[None, :, 2], NONE_ABOVE_M).min(axis=1, initial=NONE_ABOVE_M)
+        below = np.where(under, self.high[None, :, 2], 0.0).max(axis=1, initial=0.0)
         if self._rays is not None:
-            heights = np.minimum(heights, self._ray_heights(points, 1.0, NONE_ABOVE_M))
-        return heights
-
-    def below(self, points: np.ndarray) -> np.ndarray:
-        """(n,) the height of the nearest surface below each point (the ground at least)."""
-        points = np.atleast_2d(np.asarray(points, dtype=float))
-        under = self._footprint(points) & (self.high[None, :, 2] <= points[:, 2:3])
-        heights = np.where(under, self.high[None, :, 2], 0.0).max(axis=1, initial=0.0)
-        if self._rays is not None:
-            heights = np.maximum(heights, self._ray_heights(points, -1.0, 0.0))
-        return heights
+            above = np.minimum(above, self._ray_heights(points, 1.0, NONE_ABOVE_M))
+            below = np.maximum(below, self._ray_heights(points, -1.0, 0.0))
+        return above, below
 
     def _ray_heights(self, points: np.ndarray, up: float, none: float) -> np.ndarray:
         """The height where a vertical ray from each point (``up`` +1 or -1) first meets the

@@ -24,9 +24,9 @@ BELOW = [0.0, 0.0, 0.0, 9.0, 0.0]
 
 
 def test_the_boxes_give_the_deck_above_and_the_ground_or_deck_below(along_world):
-    surfaces = VerticalSurfaces(along_world.structure)
-    np.testing.assert_array_equal(surfaces.above(POINTS), ABOVE)
-    np.testing.assert_array_equal(surfaces.below(POINTS), BELOW)
+    above, below = VerticalSurfaces(along_world.structure).heights(POINTS)
+    np.testing.assert_array_equal(above, ABOVE)
+    np.testing.assert_array_equal(below, BELOW)
 
 
 def test_a_mesh_file_of_the_same_deck_gives_the_same_heights(tmp_path):
@@ -35,6 +35,6 @@ def test_a_mesh_file_of_the_same_deck_gives_the_same_heights(tmp_path):
     path = tmp_path / "deck.stl"
     deck.export(path)
     structure = build_structure(StructureSettings(mesh_file=str(path), primitives=[]))
-    surfaces = VerticalSurfaces(structure)
-    np.testing.assert_allclose(surfaces.above(POINTS), ABOVE, atol=1e-9)
-    np.testing.assert_allclose(surfaces.below(POINTS), BELOW, atol=1e-9)
+    above, below = VerticalSurfaces(structure).heights(POINTS)
+    np.testing.assert_allclose(above, ABOVE, atol=1e-9)
+    np.testing.assert_allclose(below, BELOW, atol=1e-9)
