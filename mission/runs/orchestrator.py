@@ -187,7 +187,7 @@ def _start_processes(options: RunOptions, scenario: Scenario, children: list[Chi
     gcs_main = _ground_station_main if forking else None
     gcs = _launch(options.out_dir, "ground_station", station, (), gcs_main)
     children.append(gcs)
-    vehicle_main = _vehicle_main() if forking else None
+    vehicle_main = _vehicle_main(scenario) if forking else None
     for name in names:
         fds = [sockets[name].fileno(), truth_sockets[name].fileno()]
         arguments = ["--vehicle", name, "--socket-fd", str(fds[0])]
@@ -234,9 +234,14 @@ def _compile_time(log: Path) -> float:
     return float(found.group(1)) if found else 0.0
 
 
-def _vehicle_main() -> Callable[[list[str]], int]:
-    """The vehicles' entry point, imported here once for the four forks."""
+def _vehicle_main(scenario: Scenario) -> Callable[[list[str]], int]:
+    """The vehicles' entry point, imported here once for the four forks; with flying vehicles
+    also their dynamics (casadi and scipy.signal: ~1 s of CPU each, four times at once on two
+    cores when each vehicle imported them)."""
     from vehicle_sim.cli import entry_point
+
+    if scenario.vehicle.dynamics == "multicopter":
+        import vehicle_sim.multicopter  # noqa: F401
 
     return entry_point
 
