@@ -20,18 +20,19 @@ across it and vertically: intensity ``sigma_w = turbulence x 0.1 x W20`` with
 the mean speed (at least 0.5 m/s). Shaping filters
 ``H_u = sigma_u sqrt(2 L_u / (pi V)) / (1 + (L_u / V) s)`` and
 ``H_v,w = sigma sqrt(L / (pi V)) (1 + sqrt(3) (L / V) s) / (1 + (L / V) s)^2``, discretised
-(zero-order hold) at the integration rate and driven by seeded white noise; each vehicle has
+(zero-order hold) at the integration rate and driven by seeded white noise, a block of samples
+by a few matrix products (the same numbers as scipy's ``lfilter`` to rounding); each vehicle has
 its own draw, so gusts are not correlated between vehicles. The gust scales with the local
 speed (the shelter calms it, the edges strengthen it).
 """
 
 from __future__ import annotations
 
+import functools
 import math
-import warnings
+from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal
 
 from mission.config.settings import BoxPrimitive
 from mission.config.wind_settings import WindSettings
@@ -39,6 +40,7 @@ from mission.config.wind_settings import WindSettings
 FEET = 0.3048
 MIN_HEIGHT_FT = 10.0
 MIN_SPEED_M_S = 0.5
+BLOCK = 256  # gust samples filtered at once
 
 
 def blowing_toward(from_deg: float) -> np.ndarray:
@@ -88,11 +90,60 @@ class WindField:
         return self.factor(point) * self.free_stream
 
 
+def _expm(matrix: np.ndarray) -> np.ndarray:
+    """exp(matrix) by scaling and squaring a Taylor series (small, well-scaled matrices: the
+    shaping filters' over one substep; numpy only, so a vehicle does not import scipy)."""
+    norm = float(np.abs(matrix).sum(axis=1).max())
+    squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0 else 0
+    scaled = matrix / 2.0**squarings
+    term = result = np.eye(len(matrix))
+    for k in range(1, 20):
+        term = term @ scaled / k
+        result = result + term
+    for _ in range(squarings):
+        result = result @ result
+    return result
+
+
+@dataclass(frozen=True, eq=False)  # hashed by identity: its blocks are cached per filter
+class ShapingFilter:
+    """One axis's shaping filter, discretised (zero-order hold): x' = A x + B u, y = C x,
+    u unit white noise samples, y gust samples (m/s)."""
+
+    a: np.ndarray  # (n, n)
+    b: np.ndarray  # (n,)
+    c: np.ndarray  # (n,)
+
+    @classmethod
+    def of(cls, a: np.ndarray, b: np.ndarray, c: np.ndarray, dt_s: float) -> ShapingFilter:
+        """The continuous filter (a, b, c) held over samples ``dt_s`` apart."""
+        n = len(a)
+        augmented = np.zeros((n + 1, n + 1))
+        augmented[:n, :n], augmented[:n, n] = a, b
+        held = _expm(augmented * dt_s)
+        return cls(held[:n, :n], held[:n, n], np.asarray(c, dtype=float))
+
+    @functools.cache  # noqa: B019 - a handful of filters per process, each kept for its run
+    def block(self, count: int) -> tuple[np.ndarray, ...]:
+        """For ``count`` samples at once: the outputs' response to the state (count, n) and to
+        the inputs (count, count: lower triangular), the state's to the state (n, n) and to
+        the inputs (n, count)."""
+        powers = [np.eye(len(self.a))]
+        for _ in range(count):
+            powers.append(powers[-1] @ self.a)
+        free = np.array([self.c @ power for power in powers[:count]])
+        markov = np.array([0.0] + [self.c @ power @ self.b for power in powers[: count - 1]])
+        lags = np.subtract.outer(np.arange(count), np.arange(count))
+        forced = np.where(lags >= 0, markov[np.clip(lags, 0, None)], 0.0)
+        inputs = np.column_stack([powers[count - 1 - j] @ self.b for j in range(count)])
+        return free, forced, powers[count], inputs
+
+
 def dryden_filters(
     speed_m_s: float, height_m: float, turbulence: float, dt_s: float
-) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The three axes' discrete shaping filters (b, a): along the mean wind, across it, up;
-    each turns unit white noise samples into gust samples (m/s)."""
+) -> list[ShapingFilter]:
+    """The three axes' discrete shaping filters: along the mean wind, across it, up; each
+    turns unit white noise samples into gust samples (m/s)."""
     v = max(speed_m_s, MIN_SPEED_M_S)
     h_ft = max(height_m / FEET, MIN_HEIGHT_FT)
     sigma_w = turbulence * 0.1 * speed_m_s
@@ -104,17 +155,15 @@ def dryden_filters(
         [(sigma_uv, length_uv), (sigma_uv, length_uv), (sigma_w, length_w)]
     ):
         tau = length / v
-        if axis == 0:
-            numerator = [sigma * math.sqrt(2 * length / (math.pi * v))]
-            denominator = [tau, 1.0]
-        else:
+        if axis == 0:  # K / (tau s + 1)
+            gain = sigma * math.sqrt(2 * length / (math.pi * v))
+            realised = (np.array([[-1 / tau]]), np.array([1.0]), np.array([gain / tau]))
+        else:  # K (sqrt(3) tau s + 1) / (tau s + 1)^2, in controllable canonical form
             gain = sigma * math.sqrt(length / (math.pi * v))
-            numerator = [gain * math.sqrt(3) * tau, gain]
-            denominator = [tau * tau, 2 * tau, 1.0]
-        with warnings.catch_warnings():  # a zero-order hold's numerator starts with a zero
-            warnings.simplefilter("ignore", signal.BadCoefficients)
-            b, a, _ = signal.cont2discrete((numerator, denominator), dt_s, method="zoh")
-        filters.append((np.ravel(b), np.ravel(a)))
+            a = np.array([[0.0, 1.0], [-1 / tau**2, -2 / tau]])
+            c = np.array([gain / tau**2, gain * math.sqrt(3) / tau])
+            realised = (a, np.array([0.0, 1.0]), c)
+        filters.append(ShapingFilter.of(*realised, dt_s))
     return filters
 
 
@@ -132,7 +181,7 @@ class DrydenGusts:
         self.dt_s = dt_s
         self.rng = rng
         self.filters = dryden_filters(settings.speed_m_s, height_m, settings.turbulence, dt_s)
-        self.state = [np.zeros(max(len(a), len(b)) - 1) for b, a in self.filters]
+        self.state = [np.zeros(len(f.a)) for f in self.filters]
         along = blowing_toward(settings.from_deg)
         across = np.array([-along[1], along[0], 0.0])
         self.axes = np.column_stack([along, across, [0.0, 0.0, 1.0]])
@@ -140,11 +189,17 @@ class DrydenGusts:
         self.noise_scale = math.sqrt(math.pi / dt_s)
 
     def samples(self, count: int) -> np.ndarray:
-        """(count, 3): the next ``count`` gust vectors."""
+        """(count, 3): the next ``count`` gust vectors (filtered a block of at most
+        ``BLOCK`` samples at a time: a few matrix products, no loop over samples)."""
         noise = self.rng.standard_normal((3, count)) * self.noise_scale
         gusts = np.empty((3, count))
-        for axis, (b, a) in enumerate(self.filters):
-            gusts[axis], self.state[axis] = signal.lfilter(b, a, noise[axis], zi=self.state[axis])
+        for start in range(0, count, BLOCK):
+            stop = min(start + BLOCK, count)
+            for axis, shaping in enumerate(self.filters):
+                free, forced, carry, inputs = shaping.block(stop - start)
+                u, x = noise[axis, start:stop], self.state[axis]
+                gusts[axis, start:stop] = free @ x + forced @ u
+                self.state[axis] = carry @ x + inputs @ u
         return (self.axes @ gusts).T
 
 

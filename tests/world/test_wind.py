@@ -101,3 +101,29 @@ def test_a_wind_that_cannot_be_is_refused():
         replace(WIND, from_deg=360.0)
     with pytest.raises(FieldProblem, match="does not fit the workspace"):
         replace(ALONG.world, wind=replace(WIND, edge_width_m=100.0))
+
+
+def test_the_block_filter_gives_scipys_zero_order_hold_and_lfilter_across_blocks():
+    # the independent answer: scipy's own discretisation of the same transfer functions,
+    # filtered sample by sample
+    speed, height = WIND.speed_m_s, 8.0
+    gusts = DrydenGusts(WIND, height, DT_S, np.random.default_rng(5))
+    count = 700  # two whole blocks and part of a third
+    noise = np.random.default_rng(5).standard_normal((3, count)) * gusts.noise_scale
+    ours = np.linalg.solve(gusts.axes, gusts.samples(count).T)  # back to along, across, up
+    h_ft = height / FEET
+    sigma_w = 0.1 * speed
+    sigma_uv = sigma_w / (0.177 + 0.000823 * h_ft) ** 0.4
+    length_uv = h_ft / (0.177 + 0.000823 * h_ft) ** 1.2 * FEET
+    for axis, (sigma, length) in enumerate(
+        [(sigma_uv, length_uv), (sigma_uv, length_uv), (sigma_w, height)]
+    ):
+        tau = length / speed
+        if axis == 0:
+            tf = ([sigma * np.sqrt(2 * length / (np.pi * speed))], [tau, 1.0])
+        else:
+            k = sigma * np.sqrt(length / (np.pi * speed))
+            tf = ([k * np.sqrt(3) * tau, k], [tau * tau, 2 * tau, 1.0])
+        b, a, _ = signal.cont2discrete(tf, DT_S, method="zoh")
+        theirs = signal.lfilter(np.ravel(b), np.ravel(a), noise[axis])
+        np.testing.assert_allclose(ours[axis], theirs, rtol=1e-9, atol=1e-12)
