@@ -159,6 +159,18 @@ BAD_INPUTS = [
         "less than 90",
     ),
     (
+        "overlapping rotors",
+        "vehicle: {multicopter: {rotor_radius_m: 0.2}}\n",
+        "vehicle.multicopter.rotor_radius_m",
+        "would overlap",
+    ),
+    (
+        "an infinite ceiling gain",
+        "vehicle: {multicopter: {ceiling_effect_k: 0.3}}\n",
+        "vehicle.multicopter.ceiling_effect_k",
+        "infinite",
+    ),
+    (
         "empty structure",
         "world: {structure: {primitives: []}}\n",
         "world.structure.primitives",
