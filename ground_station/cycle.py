@@ -2,7 +2,9 @@
 
 1. localize: each support's GNSS fix p_n and camera observation r_n (brought to the cycle's
    time, :mod:`~ground_station.align`), with covariances;
-2. fuse: selective fusion for the work UAV's xhat, feedback for each support's yhat_n;
+2. fuse: selective fusion for the work UAV's xhat, feedback for each support's yhat_n; with
+   ``roles.policy: dynamic`` the work UAV's own GNSS fix judged and, trusted, fused too
+   (:mod:`~ground_station.roles.own_fix`);
 3. check arrival at the current work waypoint (|w_k - xhat| < 0.1 m advances k; not when
    blind);
 4. learn: G updated around each yhat_n with the GNSS error seen there (AC only);
@@ -29,6 +31,7 @@ from ground_station.fusion import FusionResult, SupportMeasurement, fuse
 from ground_station.gnss_map import learn
 from ground_station.localize import SupportReport, localize
 from ground_station.plan import FormationPlan, plan, solve_supports
+from ground_station.roles.own_fix import OwnFix, combined_estimate, judge
 from ground_station.run_context import RunContext
 from ground_station.state import StationState
 from ground_station.support_mpc.mpc import SupportPlan
@@ -47,6 +50,13 @@ class CycleDecision:
     updated_voxels: int
     formation: FormationPlan
     elapsed_ms: float
+    own_fix: OwnFix | None = None  # the verdict on the work UAV's own fix (policy dynamic)
+
+    @property
+    def blind(self) -> bool:
+        """No estimate of the work UAV this cycle: no support contributed and its own fix
+        was not used."""
+        return self.fusion.blind and not (self.own_fix is not None and self.own_fix.used)
 
     @property
     def work_command(self) -> np.ndarray:
@@ -67,22 +77,34 @@ class CycleOutput:
     work_prediction: WorkPrediction
     support_plans: dict[str, SupportPlan]
     cycle_ms: float
+    blind: bool
+    own_fix: OwnFix | None = None
 
 
 def control_cycle(
-    state: StationState, reports: Sequence[SupportReport], context: RunContext
+    state: StationState,
+    reports: Sequence[SupportReport],
+    context: RunContext,
+    work_fix: np.ndarray | None = None,
 ) -> CycleDecision:
-    """The paper's five steps for this cycle's reports; updates ``state`` in place."""
+    """The paper's five steps for this cycle's reports (and the work UAV's own 3-D fix, ENU,
+    where it has one); updates ``state`` in place."""
     start = time.perf_counter()
-    control = context.scenario.control
+    control, roles = context.scenario.control, context.scenario.roles
     measurements = localize(align(reports, state, control.t_cont_s), context.world)  # 1
     fusion, betas = fuse(state, measurements, context.scenario.fusion, context.rng)  # 2
-    blind = fusion.blind  # no waypoint is reached on a dead-reckoned estimate
+    own = None
+    if roles.policy == "dynamic":
+        own = judge(work_fix, fusion, context.g, context.world, roles)
+        if own.used:
+            assert work_fix is not None
+            state.xhat = combined_estimate(work_fix, own, fusion)
+    blind = fusion.blind and not (own is not None and own.used)  # then no waypoint is reached
     arrived = None if blind else check_arrival(state, context.work_waypoints, control.arrival_tol_m)
     updated = learn(context.g, measurements, state.yhat)  # 4
     formation = plan(state, context, [m.name for m in measurements], hold=blind)  # 5
     elapsed_ms = (time.perf_counter() - start) * 1000
-    return CycleDecision(measurements, fusion, betas, arrived, updated, formation, elapsed_ms)
+    return CycleDecision(measurements, fusion, betas, arrived, updated, formation, elapsed_ms, own)
 
 
 def complete_cycle(
@@ -101,6 +123,8 @@ def complete_cycle(
         decision.formation.work,
         plans,
         decision.elapsed_ms + (time.perf_counter() - start) * 1000,
+        decision.blind,
+        decision.own_fix,
     )
 
 

@@ -53,7 +53,7 @@ class RunRecords:
             "t": round(time_s, 3),
             "k": state.k,
             "xhat": _rounded(state.xhat),
-            "blind": fusion.blind,
+            "blind": output.blind,
             "fallback": fusion.fallback,
             "consistent": list(fusion.consistent),
             "contributing": list(fusion.contributing),
@@ -72,6 +72,8 @@ class RunRecords:
             },
             "cycle_ms": round(output.cycle_ms, 3),
         }
+        if output.own_fix is not None:  # roles.policy dynamic
+            record["own_fix"] = output.own_fix.record()
         if ages_ms is not None:
             record["age_ms"] = ages_ms
         self._records.write(json.dumps(record) + "\n")

@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ground_station.cycle import CycleDecision, CycleOutput, complete_cycle, control_cycle
 from ground_station.links.clock import LockstepTiming, PendingStep, StationClock, await_step
 from ground_station.links.outgoing import (
@@ -25,7 +27,7 @@ from ground_station.links.outgoing import (
 )
 from ground_station.links.tlog import TlogWriter
 from ground_station.links.vehicle_links import VehicleLinks
-from ground_station.localize import SupportReport, reports_from_messages
+from ground_station.localize import SupportReport, gnss_fix, reports_from_messages
 from ground_station.preflight import arm_all, connect, upload_missions
 from ground_station.records import SNAPSHOT_EVERY, GSnapshots, RunRecords
 from ground_station.run_context import RunContext, build_run_context, require_known_world
@@ -150,7 +152,7 @@ class GroundStation:
             for name in self.links.supervise(self.config.silence_limit_s, self.clock.step_s):
                 state.forget(name)
             reports = reports_from_messages(self.links.support_samples(), self.frame)
-            decision = control_cycle(state, reports, context)
+            decision = control_cycle(state, reports, context, self._work_fix())
             work_step = self._command_work(state, decision)  # it steps while
             output = complete_cycle(state, decision, context)  # the supports' MPCs are solved
             self._command_supports(state, output)
@@ -163,6 +165,16 @@ class GroundStation:
                 self.links.announce(f"Mission complete at {self.clock.time_s:.1f} s")
                 return self.clock.time_s
         return None
+
+    def _work_fix(self) -> np.ndarray | None:
+        """The work UAV's own 3-D fix of this cycle (ENU), where the roles are dynamic (the
+        paper's fixed roles never read it)."""
+        if self.scenario.roles.policy != "dynamic":
+            return None
+        message = self.links.current("work", "GPS_RAW_INT")
+        if self.links.age_s("work", message) is None:
+            return None
+        return gnss_fix(message, self.frame)
 
     def _crashed(self) -> bool:
         """A vehicle said it crashed and the run stops on crashes: the run ends, failed."""
@@ -192,9 +204,9 @@ class GroundStation:
         supports' MPCs are solved: it steps meanwhile, and its truth is there when the supports
         step. Returns the step its tick starts (None: no tick went out)."""
         links, work = self.links, self.links.views["work"]
-        if not decision.fusion.blind:  # blind, it navigates on its own dead reckoning
+        if not decision.blind:  # blind, it navigates on its own dead reckoning
             links.queue_for(vision_position_estimate(state.xhat, self.clock.time_usec), work)
-        self._announce_sight(state, decision.fusion.blind)
+        self._announce_sight(state, decision.blind)
         time_ms = round(self.clock.time_s * 1000)
         links.queue_for(position_target(decision.work_command, time_ms, work.system_id), work)
         if decision.arrived is not None and not state.completed:

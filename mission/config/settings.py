@@ -18,6 +18,7 @@ from mission.config.errors import FieldProblem
 from mission.config.fault_settings import Fault, check_faults
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
+from mission.config.role_settings import RoleSettings
 from mission.config.wind_settings import WindSettings
 
 Vec3 = tuple[float, float, float]
@@ -347,6 +348,7 @@ class Scenario:
     vehicle: VehicleSettings
     limits: LimitSettings
     faults: list[Fault]
+    roles: RoleSettings
 
     def __post_init__(self) -> None:
         self._check_margins()
