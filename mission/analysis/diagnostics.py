@@ -7,6 +7,7 @@ ground station's ``records.jsonl``.
 from __future__ import annotations
 
 import json
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -48,8 +49,11 @@ def diagnostics(
     any_in_zone = set().union(*in_zone.values()) if in_zone else set()
     times, errors = work_errors(trace)
     zone_mask = np.array([t in any_in_zone for t in times], dtype=bool)
+    verdicts = [r["own_fix"]["reason"] for r in records if "own_fix" in r]
+    own_fix = {"own_fix_cycles": dict(sorted(Counter(verdicts).items()))} if verdicts else {}
     return {
         "supports": supports,
+        **own_fix,  # roles.policy dynamic: how often the work UAV's own fix was used, or why not
         "empty_s_cycles": sum(1 for r in records if r.get("fallback")),
         "blind_cycles": sum(1 for r in records if r.get("blind")),
         "work_error_mean_m_support_in_zone": _mean(errors[zone_mask]) if len(times) else None,

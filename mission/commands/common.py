@@ -58,14 +58,16 @@ def realtime_speedup(args: argparse.Namespace) -> float | None:
 
 def preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts: the structure's
-    mesh (loading the known world) and every vehicle's waypoint file."""
-    from mission.link.plan_check import check_plan_files
+    mesh (loading the known world), every vehicle's waypoint file, and the supports' own
+    inspection waypoints against the structure."""
+    from mission.link.plan_check import check_inspections_placed, check_plan_files
     from mission.link.plan_files import vehicle_names
     from mission.world.model import KnownWorld
 
     world = KnownWorld(scenario)
     names = vehicle_names(scenario.task.supports)
     check_plan_files(world, Path(scenario.task.waypoints_dir), names)
+    check_inspections_placed(world)
 
 
 def check_figure_path(path: Path, flag: str, made: Path | None = None) -> None:

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from mission.config.checks import positive as _positive
+from mission.config.checks import require as _require
 
 
 @dataclass(frozen=True)
@@ -23,3 +24,36 @@ class RoleSettings:
 
     def __post_init__(self) -> None:
         _positive(self, "own_fix_max_sigma_m", "own_fix_agreement_sigmas")
+
+
+@dataclass(frozen=True)
+class Inspection:
+    """What a support would photograph when the formation frees it: its own inspection
+    waypoints (ENU, m), flown in order."""
+
+    vehicle: str  # support-N
+    waypoints_m: list[tuple[float, float, float]]
+
+    def __post_init__(self) -> None:
+        _require(bool(self.waypoints_m), "waypoints_m", "needs at least one waypoint")
+
+
+def check_inspections(inspections: list[Inspection], supports: int, workspace) -> None:
+    """Each entry names a support of the scenario, once, and every waypoint lies inside the
+    workspace (inside the structure is checked with the world, before a run starts)."""
+    seen: set[str] = set()
+    names = {f"support-{n}" for n in range(1, supports + 1)}
+    for i, inspection in enumerate(inspections):
+        where = f"task.inspections[{i}]"
+        _require(
+            inspection.vehicle in names,
+            f"{where}.vehicle",
+            f"{inspection.vehicle!r} is not a support of this scenario (support-1..{supports})",
+        )
+        _require(inspection.vehicle not in seen, f"{where}.vehicle", "is listed twice")
+        seen.add(inspection.vehicle)
+        for j, point in enumerate(inspection.waypoints_m):
+            inside = all(workspace.min_m[a] <= point[a] <= workspace.max_m[a] for a in range(3))
+            _require(
+                inside, f"{where}.waypoints_m[{j}]", f"{list(point)} lies outside the workspace"
+            )

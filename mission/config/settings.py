@@ -18,7 +18,7 @@ from mission.config.errors import FieldProblem
 from mission.config.fault_settings import Fault, check_faults
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
-from mission.config.role_settings import RoleSettings
+from mission.config.role_settings import Inspection, RoleSettings, check_inspections
 from mission.config.wind_settings import WindSettings
 
 Vec3 = tuple[float, float, float]
@@ -322,6 +322,7 @@ class TaskSettings:
     supports: int
     work_waypoints_m: list[Vec3]
     waypoints_dir: str
+    inspections: list[Inspection]  # each support's own, for when it is free (issue 33)
 
     def __post_init__(self) -> None:
         _require(1 <= self.supports <= 50, "supports", f"must be in 1..50, got {self.supports}")
@@ -357,6 +358,7 @@ class Scenario:
             box = self.world.workspace
             inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))
             _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")
+        check_inspections(self.task.inspections, self.task.supports, self.world.workspace)
 
     def _check_margins(self) -> None:
         """A margin, where there is one, leaves room for the bodies it keeps apart."""

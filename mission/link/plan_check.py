@@ -93,3 +93,15 @@ def _check_row(world: KnownWorld, frame: GeodeticFrame, path: Path, row: Waypoin
     problem = world.placement_problem(position)
     if problem is not None:
         raise InputError(str(path), where, f"{shown} (ENU) lies {problem}")
+
+
+def check_inspections_placed(world: KnownWorld) -> None:
+    """Every support's own inspection waypoint where a vehicle can be (outside the
+    structure): the first that is not raises InputError naming the scenario file and field."""
+    scenario = world.scenario
+    for i, inspection in enumerate(scenario.task.inspections):
+        for j, point in enumerate(inspection.waypoints_m):
+            problem = world.placement_problem(np.asarray(point, dtype=float))
+            if problem is not None:
+                field = f"task.inspections[{i}].waypoints_m[{j}]"
+                raise InputError(scenario.source, field, f"{list(point)} lies {problem}")

@@ -1,8 +1,9 @@
 """Offline planning of the support UAVs' paths (MODEL.md 3.3, in place of the paper's [18]).
 
 For each work waypoint w_i, every support gets a point of a lattice that is free (clear of the
-structure and the ground), within camera range of w_i with a clear sight line, and has a GNSS
-fix. A point costs
+structure and the ground), within camera range of w_i with a clear sight line and no closer to
+it than the run's separation margin (``control.min_separation_m``), and has a GNSS fix. A
+point costs
 
     w_gnss sigma_0(p)^2 + w_relative tr Sigma_r(w_i - p)     (the variance it adds to mu_n)
   + w_move |p - p_{i-1}|                                    (movement)
@@ -98,7 +99,9 @@ def _candidates_for(
     settings = world.scenario.planner
     max_range = settings.max_range_fraction * world.scenario.camera.range_m
     distance = np.linalg.norm(points - waypoint, axis=1)
-    near = np.flatnonzero((distance <= max_range) & (distance > 0))
+    # no closer to the work UAV than the run's separation margin (where there is one)
+    closest = world.scenario.control.min_separation_m
+    near = np.flatnonzero((distance <= max_range) & (distance > 0) & (distance >= closest))
     visible = near[~world.structure.segments_blocked(points[near], waypoint[None])]
     if len(visible) == 0:
         raise PlanningError(

@@ -38,7 +38,25 @@ OVERLAP = (
     "  - {at_s: 20, vehicle: support-2, param: SIM_GPS1_ENABLE, value: 0}\n"
 )
 
+INSPECTIONS = "task:\n  inspections:\n    - {vehicle: %s, waypoints_m: [%s]}\n"
+
 FILE_CASES = [
+    # --- a support's own inspection waypoints (issue 33) ---------------------------------
+    (
+        "yaml-inspection-inside-the-structure",
+        lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-1", "[0.0, 0.0, 8.5]")))],
+        ["bad.yaml", "task.inspections[0].waypoints_m[0]", "inside the structure"],
+    ),
+    (
+        "yaml-inspection-outside-the-workspace",
+        lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-2", "[0.0, 0.0, 99.0]")))],
+        ["bad.yaml", "task.inspections[0].waypoints_m[0]", "outside the workspace"],
+    ),
+    (
+        "yaml-inspection-of-no-such-support",
+        lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-7", "[0.0, -12.0, 7.0]")))],
+        ["bad.yaml", "task.inspections[0].vehicle", "not a support of this scenario"],
+    ),
     # --- safety margins ----------------------------------------------------------------
     (
         "yaml-negative-margin",
