@@ -69,13 +69,6 @@ class ContactDetector:
         self.proximity = proximity
         self.radius_m = radius_m
 
-    def with_surroundings(
-        self, start: np.ndarray, end: np.ndarray, start_s: float, end_s: float
-    ) -> list[Contact]:
-        """The first contact with the structure and the first with the ground along a step from
-        ``start`` to ``end``."""
-        return self.along(np.vstack([start, end]), start_s, end_s)
-
     def along(self, path: np.ndarray, start_s: float, end_s: float) -> list[Contact]:
         """The first contact with the structure and the first with the ground along ``path``
         ((n, 3) positions at equal times from ``start_s`` to ``end_s``: a flying body's

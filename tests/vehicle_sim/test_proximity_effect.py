@@ -121,7 +121,7 @@ def _fly_under_the_deck(along_world, vehicle, gust_m_s: float):
         peak = max(peak, float(body.path[:, 2].max()))
         start_s, end_s = 0.5 * step, 0.5 * (step + 1)
         along += detector.along(body.path, start_s, end_s)
-        ends += detector.with_surroundings(body.path[0], body.path[-1], start_s, end_s)
+        ends += detector.along(body.path[[0, -1]], start_s, end_s)  # the step's ends only
     return peak, along, ends
 
 
