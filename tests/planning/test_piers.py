@@ -1,7 +1,8 @@
 """The piers scenario (issue 33): an inspection that leaves the deck's shadow. Its shipped plan
-keeps the run's margins (that the planner reproduces its plans byte for byte is Along's test); its work path lies partly in the
-open, where the station's sky model expects a fix, and partly in the shadow, where it does not;
-each support has inspection waypoints of its own, clear of the structure."""
+keeps the run's margins (that the planner reproduces its plans byte for byte is Along's test);
+its work path lies partly in the open, where the station's sky model expects a fix, and partly
+in the shadow, where it does not; each support has inspection waypoints of its own, clear of
+the structure."""
 
 from __future__ import annotations
 
