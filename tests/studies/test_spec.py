@@ -50,6 +50,9 @@ def test_a_scenario_path_is_relative_to_the_study_file(tmp_path):
     assert spec.scenarios == (str((tmp_path / "sub" / "mine.yaml").resolve()), "wall")
 
 
+ONE_METHOD = {"ceiling": "the question is the deck's distance, not the method"}
+
+
 def test_every_shipped_study_is_valid():
     root = Path(__file__).resolve().parents[2] / "studies"
     names = sorted(p.stem for p in root.glob("*.yaml"))
@@ -58,7 +61,8 @@ def test_every_shipped_study_is_valid():
         spec = load_study(path)
         assert spec.name == path.stem
         if path.stem != "smoke":  # the studies of the report: at least 15 paired seeds
-            assert len(spec.seeds) >= 15 and set(spec.methods) == {"ac", "nac"}
+            assert len(spec.seeds) >= 15 and "ac" in spec.methods
+            assert set(spec.methods) == {"ac", "nac"} or path.stem in ONE_METHOD, path.stem
 
 
 GRID_WEIGHTS = ("gnss", "interval", "waypoint", "relative", "penalty")
