@@ -82,13 +82,28 @@ def solve_supports(
     the helper process); each plan's commanded displacement and path (the next warm start) go
     into ``state``."""
     work = formation.work
-    requests = [support_request(state, name, work, context) for name in formation.supports]
-    plans = context.planner.plan_all(requests)
     control = context.scenario.control
     reach = control.s_max_support_m_s * control.t_cont_s
+    # a support blown far outside the workspace is brought back straight, not planned: the MPC's
+    # map and margins hold inside it (and a solve posed far outside can fail to return)
+    lost = {n for n in formation.supports if not _near_workspace(state.yhat[n], context)}
+    requests = [
+        support_request(state, name, work, context)
+        for name in formation.supports
+        if name not in lost
+    ]
+    plans = context.planner.plan_all(requests)
+    for name in sorted(lost):
+        plans[name] = _straight_back(state, name, context, reach)
+    for name, support_plan in list(plans.items()):
+        if not _plausible(support_plan.path, state.yhat[name], reach):
+            plans[name] = _held(support_plan, state.yhat[name])  # a diverged solve: hold
     for name, support_plan in plans.items():
         state.last_support_command[name] = reachable(state.yhat[name], support_plan.command, reach)
-        state.warm[name] = support_plan.path
+        if support_plan.status == REJECTED:  # no warm start from it
+            state.warm.pop(name, None)
+        else:
+            state.warm[name] = support_plan.path
     return plans
 
 
@@ -131,3 +146,40 @@ def others_predicted(
         else:
             others.append(np.vstack([warm[1:], warm[-1:]]))
     return np.array(others)
+
+
+REJECTED = "REJECTED_DIVERGED"
+STRAY_M = 10.0  # an estimate this far outside the workspace is not planned by the MPC
+DIVERGED_STEPS = 5.0  # a plan's step this many times the reach is a solve gone wrong
+
+
+def _near_workspace(position: np.ndarray, context: RunContext) -> bool:
+    box = context.scenario.world.workspace
+    low, high = np.array(box.min_m) - STRAY_M, np.array(box.max_m) + STRAY_M
+    return bool(np.all(np.isfinite(position)) and np.all((position >= low) & (position <= high)))
+
+
+def _plausible(path: np.ndarray, yhat: np.ndarray, reach: float) -> bool:
+    """A plan that is finite and whose steps are not many times what the support can fly."""
+    if not np.all(np.isfinite(path)):
+        return False
+    steps = np.linalg.norm(np.diff(np.vstack([yhat, path]), axis=0), axis=1)
+    return bool(np.all(steps <= DIVERGED_STEPS * reach))
+
+
+def _held(plan: SupportPlan, yhat: np.ndarray) -> SupportPlan:
+    path = np.repeat(np.asarray(yhat, dtype=float)[None], len(plan.path), axis=0)
+    return SupportPlan(path, REJECTED, plan.solve_ms, plan.blocked, False, plan.anchors)
+
+
+def _straight_back(state: StationState, name: str, context: RunContext, reach: float):
+    """A support far outside the workspace flies straight toward its current waypoint."""
+    yhat = state.yhat[name]
+    target = context.support_waypoints[name][min(state.k, len(context.support_waypoints[name]) - 1)]
+    horizon = context.scenario.control.horizon_steps
+    direction = target - yhat
+    distance = float(np.linalg.norm(direction))
+    steps = np.arange(1, horizon + 1)[:, None] * reach
+    path = yhat + direction / max(distance, 1e-9) * np.minimum(steps, distance)
+    none = np.zeros(0)
+    return SupportPlan(path, "OUTSIDE_WORKSPACE", 0.0, np.zeros(horizon, dtype=bool), False, none)
