@@ -19,25 +19,14 @@ import numpy as np
 
 from mission.world.structure import Structure
 
-BOX_FACES = 12  # triangles a box primitive adds to the structure's mesh
-
 
 class StructureProximity:
     """Distances from points to the structure's convex pieces, and separating half-spaces."""
 
     def __init__(self, structure: Structure) -> None:
-        boxes = structure.boxes
-        self.low = np.array([b.min_m for b in boxes], dtype=float).reshape(-1, 3)
-        self.high = np.array([b.max_m for b in boxes], dtype=float).reshape(-1, 3)
-        extra = structure.faces[BOX_FACES * len(boxes) :]
-        self._file_mesh = None
-        if len(extra):
-            import trimesh  # a mesh file's world imports it anyway
-
-            used = np.unique(extra)
-            remap = np.full(len(structure.vertices), -1)
-            remap[used] = np.arange(len(used))
-            self._file_mesh = trimesh.Trimesh(structure.vertices[used], remap[extra], process=False)
+        self.low, self.high = structure.box_low, structure.box_high
+        self._file_mesh = structure.file_mesh
+        if self._file_mesh is not None:
             self._file_solid = structure.solid_file_mesh
 
     @property

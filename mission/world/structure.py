@@ -40,8 +40,8 @@ class Structure:
         self.faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
         self.rays = best_ray_engine(self.vertices, self.faces)
         self.boxes = boxes
-        self._box_min = np.array([b.min_m for b in boxes]).reshape(-1, 3)
-        self._box_max = np.array([b.max_m for b in boxes]).reshape(-1, 3)
+        self.box_low = np.array([b.min_m for b in boxes], dtype=float).reshape(-1, 3)
+        self.box_high = np.array([b.max_m for b in boxes], dtype=float).reshape(-1, 3)
         self._solid_file_mesh = solid_file_mesh
 
     @cached_property
@@ -50,6 +50,20 @@ class Structure:
         import trimesh
 
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+    @cached_property
+    def file_mesh(self) -> trimesh.Trimesh | None:
+        """The mesh file's triangles alone (those after the box primitives') as a trimesh mesh
+        of the vertices they use; None without a mesh file."""
+        extra = self.faces[len(_BOX_FACES) * len(self.boxes) :]
+        if not len(extra):
+            return None
+        import trimesh  # a mesh file's world imports it anyway
+
+        used = np.unique(extra)
+        remap = np.full(len(self.vertices), -1)
+        remap[used] = np.arange(len(used))
+        return trimesh.Trimesh(self.vertices[used], remap[extra], process=False)
 
     @property
     def solid_file_mesh(self) -> trimesh.Trimesh | None:
@@ -92,11 +106,11 @@ class Structure:
         """True for points inside a solid of the structure (boxes, or a watertight mesh file)."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         inside = np.zeros(len(points), dtype=bool)
-        if len(self._box_min):
+        if len(self.box_low):
             inside |= np.any(
                 np.all(
-                    (points[:, None, :] > self._box_min[None] + _EPS)
-                    & (points[:, None, :] < self._box_max[None] - _EPS),
+                    (points[:, None, :] > self.box_low[None] + _EPS)
+                    & (points[:, None, :] < self.box_high[None] - _EPS),
                     axis=2,
                 ),
                 axis=1,

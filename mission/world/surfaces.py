@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from mission.world.proximity import BOX_FACES
 from mission.world.structure import Structure
 
 NONE_ABOVE_M = 1.0e6  # the height reported where nothing is above
@@ -22,15 +21,12 @@ class VerticalSurfaces:
     """Heights of the nearest surface above and below points, for one structure."""
 
     def __init__(self, structure: Structure) -> None:
-        boxes = structure.boxes
-        self.low = np.array([b.min_m for b in boxes], dtype=float).reshape(-1, 3)
-        self.high = np.array([b.max_m for b in boxes], dtype=float).reshape(-1, 3)
-        extra = structure.faces[BOX_FACES * len(boxes) :]
+        self.low, self.high = structure.box_low, structure.box_high
+        mesh = structure.file_mesh
         self._rays = None
-        if len(extra):
+        if mesh is not None:
             import trimesh
 
-            mesh = trimesh.Trimesh(structure.vertices, extra, process=False)
             self._rays = trimesh.ray.ray_triangle.RayMeshIntersector(mesh)
 
     def _footprint(self, points: np.ndarray) -> np.ndarray:
