@@ -58,15 +58,20 @@ def realtime_speedup(args: argparse.Namespace) -> float | None:
 
 def preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts: the structure's
-    mesh (loading the known world), every vehicle's waypoint file, and the supports' own
-    inspection waypoints against the structure."""
-    from mission.link.plan_check import check_inspections_placed, check_plan_files
+    mesh (loading the known world), every vehicle's waypoint file (the work UAV's the
+    scenario's path), and the supports' own inspection waypoints against the structure."""
+    from mission.link.plan_check import (
+        check_inspections_placed,
+        check_plan_files,
+        check_work_plan_matches,
+    )
     from mission.link.plan_files import vehicle_names
     from mission.world.model import KnownWorld
 
     world = KnownWorld(scenario)
     names = vehicle_names(scenario.task.supports)
     check_plan_files(world, Path(scenario.task.waypoints_dir), names)
+    check_work_plan_matches(world, Path(scenario.task.waypoints_dir))
     check_inspections_placed(world)
 
 

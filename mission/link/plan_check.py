@@ -105,3 +105,28 @@ def check_inspections_placed(world: KnownWorld) -> None:
             if problem is not None:
                 field = f"task.inspections[{i}].waypoints_m[{j}]"
                 raise InputError(scenario.source, field, f"{list(point)} lies {problem}")
+
+
+FILE_ROUNDING_M = 0.12  # a waypoint file holds 6 decimals of a degree (about 0.1 m)
+
+
+def check_work_plan_matches(world: KnownWorld, directory: Path) -> None:
+    """The work UAV's waypoint file is the scenario's ``task.work_waypoints_m`` (what the
+    planner wrote for it): a path edited in the scenario and not planned again would fly the
+    old file's. The first waypoint that differs raises InputError naming the file and item."""
+    from mission.link.plan_files import read_vehicle_waypoints
+
+    scenario = world.scenario
+    path = Path(directory) / "work.waypoints"
+    flown = read_vehicle_waypoints(scenario, "work")
+    wanted = np.asarray(scenario.task.work_waypoints_m, dtype=float)
+    again = "; plan it again (python -m mission plan SCENARIO)"
+    if len(flown) != len(wanted):
+        problem = f"{len(flown)} waypoints, the scenario's task.work_waypoints_m {len(wanted)}"
+        raise InputError(str(path), "", problem + again)
+    far = np.flatnonzero(np.linalg.norm(flown - wanted, axis=1) > FILE_ROUNDING_M)
+    if len(far):
+        i = int(far[0])
+        shown = [round(float(v), 2) for v in flown[i]]
+        problem = f"{shown} (ENU), not task.work_waypoints_m[{i}] {[float(v) for v in wanted[i]]}"
+        raise InputError(str(path), f"item {i + 1}", problem + again)

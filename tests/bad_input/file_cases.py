@@ -40,7 +40,15 @@ OVERLAP = (
 
 INSPECTIONS = "task:\n  inspections:\n    - {vehicle: %s, waypoints_m: [%s]}\n"
 
+NEW_PATH = "task: {work_waypoints_m: [[-12.0, -3.0, 7.0], [-12.0, 3.0, 7.0]]}\n"
+
 FILE_CASES = [
+    # --- a work path edited in the scenario and not planned again ---------------------------
+    (
+        "yaml-work-path-not-planned-again",
+        lambda t: [*RUN, str(scenario_file(t, NEW_PATH))],
+        ["work.waypoints", "task.work_waypoints_m 2", "plan it again"],
+    ),
     # --- a support's own inspection waypoints (issue 33) ---------------------------------
     (
         "yaml-inspection-inside-the-structure",
