@@ -54,9 +54,8 @@ class CycleDecision:
 
     @property
     def blind(self) -> bool:
-        """No estimate of the work UAV this cycle: no support contributed and its own fix
-        was not used."""
-        return self.fusion.blind and not (self.own_fix is not None and self.own_fix.used)
+        """No estimate of the work UAV this cycle."""
+        return is_blind(self.fusion, self.own_fix)
 
     @property
     def work_command(self) -> np.ndarray:
@@ -77,8 +76,17 @@ class CycleOutput:
     work_prediction: WorkPrediction
     support_plans: dict[str, SupportPlan]
     cycle_ms: float
-    blind: bool
     own_fix: OwnFix | None = None
+
+    @property
+    def blind(self) -> bool:
+        """No estimate of the work UAV this cycle."""
+        return is_blind(self.fusion, self.own_fix)
+
+
+def is_blind(fusion: FusionResult, own_fix: OwnFix | None) -> bool:
+    """No support contributed and the work UAV's own fix was not used."""
+    return fusion.blind and not (own_fix is not None and own_fix.used)
 
 
 def control_cycle(
@@ -99,7 +107,7 @@ def control_cycle(
         if own.used:
             assert work_fix is not None
             state.xhat = combined_estimate(work_fix, own, fusion)
-    blind = fusion.blind and not (own is not None and own.used)  # then no waypoint is reached
+    blind = is_blind(fusion, own)  # then no waypoint is reached
     arrived = None if blind else check_arrival(state, context.work_waypoints, control.arrival_tol_m)
     updated = learn(context.g, measurements, state.yhat)  # 4
     formation = plan(state, context, [m.name for m in measurements], hold=blind)  # 5
@@ -123,7 +131,6 @@ def complete_cycle(
         decision.formation.work,
         plans,
         decision.elapsed_ms + (time.perf_counter() - start) * 1000,
-        decision.blind,
         decision.own_fix,
     )
 

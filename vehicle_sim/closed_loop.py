@@ -86,10 +86,9 @@ class ClosedLoop:
         surfaces: np.ndarray = OPEN_AIR,
     ) -> tuple[np.ndarray, np.ndarray]:
         """(the state a step later, (n, 3) the position after every few substeps, the last one
-        the step's end: :func:`path_stride`); ``wind``
-        (3,) held over the step, or (substeps, 3) one vector a substep; ``surfaces`` the
-        heights above, then below, each rotor (:data:`~vehicle_sim.rigid_body.OPEN_AIR`:
-        none near)."""
+        the step's end: :func:`path_stride`); ``wind`` (3,) held over the step, or
+        (substeps, 3) one vector a substep; ``surfaces`` the heights above, then below, each
+        rotor (:data:`~vehicle_sim.rigid_body.OPEN_AIR`: none near)."""
         wind = np.asarray(wind, dtype=float)
         winds = np.repeat(wind.reshape(3, 1), self.substeps, axis=1) if wind.ndim == 1 else wind.T
         final, path = self._step(state, target, belief_offset, speed_limit_m_s, surfaces, winds)

@@ -66,7 +66,7 @@ def rotor_offsets(settings: MulticopterSettings) -> np.ndarray:
 
 def proximity_gain(k: float, radius_m: float, clip_radii: float, distance_m):
     """A rotor's thrust gain ``distance_m`` from a surface: 1 / (1 - k (R/d)^2), d held at
-    ``clip_radii`` rotor radii closer in (casadi or numpy)."""
+    ``clip_radii`` rotor radii closer in (a casadi expression; numbers give a casadi DM)."""
     held = ca.fmax(distance_m, clip_radii * radius_m)
     return 1 / (1 - k * (radius_m / held) ** 2)
 

@@ -236,8 +236,8 @@ def _compile_time(log: Path) -> float:
 
 def _vehicle_main(scenario: Scenario) -> Callable[[list[str]], int]:
     """The vehicles' entry point, imported here once for the four forks; with flying vehicles
-    also their dynamics (casadi and scipy.signal: ~1 s of CPU each, four times at once on two
-    cores when each vehicle imported them)."""
+    also their dynamics (casadi and the flight code), which each would otherwise import for
+    itself, four at once on two cores."""
     from vehicle_sim.cli import entry_point
 
     if scenario.vehicle.dynamics == "multicopter":

@@ -11,13 +11,14 @@ import pytest
 
 from mission.config.errors import InputError
 from mission.config.scenario import load_scenario
+from mission.link.plan_check import FILE_ROUNDING_M
 from mission.link.plan_files import read_plan, vehicle_names
 from mission.link.waypoints import read_waypoints
 from mission.planning.planner import PlanningError, plan_supports
 from mission.planning.zone_placement import inside, path_samples
 from mission.world.model import World
 
-ROUNDING_M = 0.12  # files hold 6 decimals of a degree (about 0.1 m)
+ROUNDING_M = FILE_ROUNDING_M  # files hold 6 decimals of a degree (about 0.1 m)
 
 
 @pytest.fixture(scope="module")
