@@ -27,6 +27,8 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.analysis.safety import safety_metrics
+from mission.analysis.spread import spread
+from mission.analysis.tracking import tracking_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate, truth_time
 from mission.config.settings import Scenario
 from mission.link.fast_decode import FastDecoder
@@ -41,6 +43,7 @@ _CONTACT = re.compile(r"^(Crash|Contact): (\S+) t=(-?[\d.]+) at (-?[\d.]+),(-?[\
 _WANTED_IDS = frozenset(
     {
         mavlink2.MAVLINK_MSG_ID_SIM_STATE,
+        mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED,
         mavlink2.MAVLINK_MSG_ID_VISION_POSITION_ESTIMATE,
         mavlink2.MAVLINK_MSG_ID_SET_POSITION_TARGET_LOCAL_NED,
         mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME,
@@ -55,7 +58,11 @@ class RunTrace:
     """What a ground station's tlog says about a run, in simulated seconds."""
 
     truth: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
-    estimates: dict[float, np.ndarray] = field(default_factory=dict)
+    estimates: dict[float, np.ndarray] = field(default_factory=dict)  # the work UAV's, by time
+    # every vehicle's belief (LOCAL_POSITION_NED), setpoints and the estimates sent before them
+    beliefs: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    setpoints: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    sent_estimates: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     cycles: set[float] = field(default_factory=set)  # times of the work UAV's setpoints
     ticks: set[float] = field(default_factory=set)
     completion: float | None = None
@@ -118,7 +125,9 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     trace = RunTrace(max_gap_s=2 * sample_s)
     pending_estimate: tuple[float, np.ndarray] | None = None
     pending_truth: dict[int, np.ndarray] = {}  # a vehicle's SIM_STATE awaiting its step's stamp
+    pending_belief: dict[int, np.ndarray] = {}  # its LOCAL_POSITION_NED, likewise
     stamped: list[tuple[int, int, np.ndarray]] = []  # (system, stamp in usec, position)
+    stamped_beliefs: list[tuple[int, int, np.ndarray]] = []
     replies: list[TimesyncReply] = []
     for message in messages:
         kind = message.get_type()
@@ -126,9 +135,14 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         source = message.get_srcSystem()
         if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
             pending_truth[source] = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
+        elif kind == "LOCAL_POSITION_NED" and source != GCS_SYSTEM_ID:
+            pending_belief[source] = ned_to_enu(np.array([message.x, message.y, message.z]))
         elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
+            stamp = int(message.time_unix_usec)
             if source in pending_truth:
-                stamped.append((source, int(message.time_unix_usec), pending_truth.pop(source)))
+                stamped.append((source, stamp, pending_truth.pop(source)))
+            if source in pending_belief:
+                stamped_beliefs.append((source, stamp, pending_belief.pop(source)))
         elif kind == "STATUSTEXT" and source != GCS_SYSTEM_ID:
             contact = _CONTACT.match(message.text)
             if contact:
@@ -144,7 +158,11 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "VISION_POSITION_ESTIMATE":
             pending_estimate = (t, ned_to_enu(np.array([message.x, message.y, message.z])))
         elif kind == "SET_POSITION_TARGET_LOCAL_NED":
-            if message.target_system == 1:
+            target = message.target_system
+            trace.setpoints[(target, t)] = ned_to_enu(np.array([message.x, message.y, message.z]))
+            if pending_estimate is not None:
+                trace.sent_estimates[(target, t)] = pending_estimate[1]
+            if target == 1:
                 trace.cycles.add(t)
                 if pending_estimate is not None:
                     trace.estimates[pending_estimate[0]] = pending_estimate[1]
@@ -159,11 +177,10 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             trace.link_events.append({"t": t, "event": message.text})
     offsets = {} if trace.ticks else clock_offsets(replies)
     epoch_usec = round(epoch * 1e6)
-    for system, stamp, position in stamped:
-        if trace.ticks or system in offsets:
-            trace.truth[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = (
-                position
-            )
+    for samples, into in ((stamped, trace.truth), (stamped_beliefs, trace.beliefs)):
+        for system, stamp, position in samples:
+            if trace.ticks or system in offsets:
+                into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
     return trace
 
 
@@ -275,20 +292,13 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "control_cycles": len(trace.cycles),
         "multipath_steps": counts,
         "multipath_steps_total": int(sum(counts.values())),
-        "work_error_m": _stats([float(e) for e in errors]),
+        "work_error_m": spread([float(e) for e in errors]),
+        "tracking_error_m": tracking_metrics(
+            trace, world.scenario.control.s_max_work_m_s, world.scenario.control.s_max_support_m_s
+        ),
         "link_events": trace.link_events,
         "events": sorted(trace.events, key=lambda e: (e["t"], e["vehicle"])),
         "safety": safety_metrics(trace, world),
-    }
-
-
-def _stats(values: list[float]) -> dict[str, float | None]:
-    if not values:
-        return {"mean": None, "p95": None, "max": None}
-    return {
-        "mean": round(float(np.mean(values)), 4),
-        "p95": round(float(np.percentile(values, 95)), 4),
-        "max": round(float(np.max(values)), 4),
     }
 
 

@@ -17,6 +17,7 @@ from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import check_seed
 from mission.procs.outputs import check_output_dir
+from mission.runs.stall import DEFAULT_STALL_S
 
 
 def add_parser(commands) -> None:
@@ -59,6 +60,14 @@ def add_parser(commands) -> None:
         "what G learned), none (a lean run, as a study's that keeps no g/)",
     )
     parser.add_argument(
+        "--stall-s",
+        type=float,
+        default=DEFAULT_STALL_S,
+        metavar="S",
+        help="stop the run, as failed and with its logs, when its tlog has not grown for S "
+        f"seconds of wall time (a hung solver or wait; default {DEFAULT_STALL_S:g}, 0: never)",
+    )
+    parser.add_argument(
         "--process-start",
         choices=["fork", "exec"],
         default="fork",
@@ -90,6 +99,10 @@ def run(args: argparse.Namespace) -> int:
 
         die_with_parent()
     check_seed(args.seed)
+    if not (0 <= args.stall_s < float("inf")):
+        raise InputError(
+            "command line", "--stall-s", f"must be finite and >= 0, not {args.stall_s}"
+        )
     speedup = realtime_speedup(args)
     scenario = load_scenario(args.scenario)
     preflight(scenario)
@@ -120,6 +133,7 @@ def run(args: argparse.Namespace) -> int:
         args.mpc_helper,
         args.process_start,
         args.g_snapshots,
+        args.stall_s,
     )
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     live = None

@@ -33,6 +33,7 @@ from mission.procs.file_tail import FileTail
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
 from mission.procs.stopping import stop_processes
+from mission.runs.stall import DEFAULT_STALL_S, StallWatch
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
 SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
@@ -61,8 +62,11 @@ class RunOptions:
     mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
     process_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
     g_snapshots: Literal["every", "ends", "none"] = "every"  # the ground station's G snapshots
+    stall_s: float = DEFAULT_STALL_S  # wall seconds without progress that stop it (0: never)
 
     def __post_init__(self) -> None:
+        if not (self.stall_s >= 0 and self.stall_s != float("inf")):
+            raise ValueError(f"stall_s must be finite and >= 0, not {self.stall_s!r}")
         if self.process_start not in ("fork", "exec"):
             raise ValueError(f"process_start must be fork or exec, not {self.process_start!r}")
         if self.g_snapshots not in ("every", "ends", "none"):
@@ -100,7 +104,8 @@ def run_mission(
         try:
             try:
                 gcs = _start_processes(options, scenario, children)
-                _supervise(gcs, children, {"work"}, watcher, stop)
+                stall = StallWatch(options.out_dir / "gcs.tlog", options.stall_s)
+                _supervise(gcs, children, {"work"}, watcher, stop, stall)
                 if gcs.process.returncode != 0:
                     status = gcs.process.returncode
                     raise RunFailed(f"ground_station exited with status {status}{_why(gcs.log)}")
@@ -304,10 +309,12 @@ def _supervise(
     required: set[str],
     watcher: RunWatcher | None,
     stop: StopRequest,
+    stall: StallWatch | None = None,
 ) -> None:
     """Wait for the ground station; a dead required vehicle, or one that never started,
-    ends the run with an error. What the ground station says of a first run's compilation is
-    shown as it comes; the watcher is polled."""
+    ends the run with an error, and so does a stall (``stall``: its tlog has not grown for
+    its limit). What the ground station says of a first run's compilation is shown as it
+    comes; the watcher is polled."""
     relay = LogRelay(gcs.log, COMPILE_NEWS)
     while True:
         stop.check()
@@ -319,6 +326,12 @@ def _supervise(
             relay.poll()
             if watcher is not None:
                 watcher.poll()
+        compiling = relay.said(COMPILE_NEWS[0]) and not relay.said(COMPILE_NEWS[1])
+        if stall is not None and stall.stalled(paused=compiling):
+            raise RunFailed(
+                f"stalled: {stall.progress.name} did not grow for {stall.limit_s:g} s of wall "
+                f"time{_why(gcs.log)}"
+            )
         for child in children:
             if child is gcs or child.process.poll() is None:
                 continue
@@ -339,6 +352,10 @@ class LogRelay:
         self.log = log
         self.pending = list(prefixes)
         self._file = FileTail(log)
+
+    def said(self, prefix: str) -> bool:
+        """Whether a line starting with ``prefix`` (one of the prefixes) has been shown."""
+        return prefix not in self.pending
 
     def poll(self) -> None:
         """Show what has come since the last poll."""

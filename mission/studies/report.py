@@ -22,6 +22,8 @@ METRICS = (
     ("inclusion_rate", "fused while in a zone"),
     ("diagnostics.empty_s_cycles", "cycles with S empty"),
     ("diagnostics.time_beyond_flight_s", "time beyond pure flight [s]"),
+    ("tracking_error_m.work.p95", "work UAV tracking error, p95 [m]"),
+    ("tracking_error_m.supports.p95", "supports' tracking error, p95 [m]"),
     ("safety.closest_approach_min_m", "closest approach of two UAVs [m]"),
     ("safety.least_clearance_min_m", "least clearance of a UAV [m]"),
     ("safety.touching", "contacts (from the truth)"),

@@ -22,6 +22,7 @@ COMMAND_CASES = [
     ("run-link-loss", lambda t: [*RUN, "--link-loss", "1.5"], ["--link-loss"]),
     ("run-link-delay", lambda t: [*RUN, "--link-delay-ms", "-3"], ["--link-delay-ms"]),
     ("run-observer", lambda t: [*RUN, "--observer", "qgc"], ["--observer"]),
+    ("run-stall", lambda t: [*RUN, "--stall-s", "-5"], ["--stall-s", ">= 0"]),
     ("batch-trials", lambda t: ["batch", "--trials", "0"], ["--trials"]),
     ("batch-jobs", lambda t: ["batch", "--jobs", "0"], ["--jobs"]),
     ("batch-speedup-alone", lambda t: ["batch", "--speedup", "10"], ["--speedup", "--realtime"]),

@@ -118,6 +118,9 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert set(summary["multipath_steps"]) == {"support-1", "support-2", "support-3"}
     assert summary["multipath_steps_total"] == sum(summary["multipath_steps"].values())
     assert 0 < summary["work_error_m"]["mean"] < 1.0
+    # a kinematic point reaches what the ideal vehicle of the tracking error reaches
+    assert summary["tracking_error_m"]["work"]["max"] < 1e-4
+    assert summary["tracking_error_m"]["supports"]["max"] < 1e-4
     assert summary["mpc_solve_ms"]["median"] > 0
     cpu = summary["cpu_s"]  # per process; together, what this test saw the run's tree use
     assert set(cpu) == {"orchestrator", "ground_station", "work", *summary["multipath_steps"]}
@@ -206,6 +209,9 @@ def _same_trace(a, b) -> bool:
         and a.link_events == b.link_events
         and arrays_equal(a.truth, b.truth)
         and arrays_equal(a.estimates, b.estimates)
+        and arrays_equal(a.beliefs, b.beliefs)
+        and arrays_equal(a.setpoints, b.setpoints)
+        and arrays_equal(a.sent_estimates, b.sent_estimates)
     )
 
 

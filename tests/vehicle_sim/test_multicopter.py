@@ -62,6 +62,9 @@ def test_a_run_with_multicopters_flies_its_first_minute(tmp_path):
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["control_cycles"] == 120 and not summary["safety"]["contacts"]
     assert summary["work_error_m"]["mean"] < 0.5  # the formation localizes a flying work UAV
+    tracking = summary["tracking_error_m"]  # a flying body lags the ideal point, not by much
+    assert 0.005 < tracking["work"]["mean"] < tracking["work"]["max"] < 0.5
+    assert 0.02 < tracking["supports"]["mean"] < tracking["supports"]["max"] < 1.5
     import os
 
     os.environ.setdefault("MAVLINK20", "1")
