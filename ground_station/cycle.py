@@ -7,8 +7,11 @@
    (:mod:`~ground_station.roles.own_fix`);
 3. check arrival at the current work waypoint (|w_k - xhat| < 0.1 m advances k; not when
    blind);
-4. learn: G updated around each yhat_n with the GNSS error seen there (AC only);
-5. plan: the work UAV's path (Algorithm 1; blind, it holds), then each support's MPC around it.
+4. learn: G updated around each yhat_n with the GNSS error seen there (AC only); then, where
+   the supports have inspections of their own, who is in the formation and who inspects
+   (:mod:`~ground_station.roles.allocation`);
+5. plan: the work UAV's path (Algorithm 1; blind, it holds), then each formation support's MPC
+   around it (a support off the formation flies its route).
 
 :func:`control_cycle` runs the five steps up to the work UAV's plan; :func:`complete_cycle`
 then poses and solves the supports' MPCs. The ground station sends the work UAV its command
@@ -31,6 +34,7 @@ from ground_station.fusion import FusionResult, SupportMeasurement, fuse
 from ground_station.gnss_map import learn
 from ground_station.localize import SupportReport, localize
 from ground_station.plan import FormationPlan, plan, solve_supports
+from ground_station.roles.allocation import allocate
 from ground_station.roles.own_fix import OwnFix, combined_estimate, judge
 from ground_station.run_context import RunContext
 from ground_station.state import StationState
@@ -110,7 +114,9 @@ def control_cycle(
     blind = is_blind(fusion, own)  # then no waypoint is reached
     arrived = None if blind else check_arrival(state, context.work_waypoints, control.arrival_tol_m)
     updated = learn(context.g, measurements, state.yhat)  # 4
-    formation = plan(state, context, [m.name for m in measurements], hold=blind)  # 5
+    allocate(state, context, state.allocation)
+    members = state.allocation.members([m.name for m in measurements])
+    formation = plan(state, context, members, hold=blind)  # 5
     elapsed_ms = (time.perf_counter() - start) * 1000
     return CycleDecision(measurements, fusion, betas, arrived, updated, formation, elapsed_ms, own)
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ground_station.gnss_map import hermite_zero_slope
+from ground_station.roles.allocation import routed_plans
 from ground_station.run_context import RunContext
 from ground_station.state import StationState, reachable
 from ground_station.support_mpc.mpc import PlanRequest, SupportPlan
@@ -93,6 +94,7 @@ def solve_supports(
         if name not in lost
     ]
     plans = context.planner.plan_all(requests)
+    plans.update(routed_plans(state, context, state.allocation))  # supports off the formation
     for name in sorted(lost):
         plans[name] = _straight_back(state, name, context, reach)
     for name, support_plan in list(plans.items()):

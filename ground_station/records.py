@@ -74,6 +74,8 @@ class RunRecords:
         }
         if output.own_fix is not None:  # roles.policy dynamic
             record["own_fix"] = output.own_fix.record()
+        if state.allocation.supports:  # the supports have inspections of their own
+            record["roles"] = state.allocation.record()
         if ages_ms is not None:
             record["age_ms"] = ages_ms
         self._records.write(json.dumps(record) + "\n")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -12,12 +12,14 @@ from ground_station.support_mpc.mpc import SupportMpc
 from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
 from mission.config.settings import Scenario
 from mission.world.model import KnownWorld, World
+from mission.world.routes import RouteMap, route_map
 
 
 @dataclass
 class RunContext:
     """The scenario and the known world, the planned waypoints, the map G, the support MPC,
-    the fusion's random generator and who solves the support MPCs."""
+    the fusion's random generator, who solves the support MPCs, and, where the supports have
+    inspections of their own, those waypoints and the routes to fly them."""
 
     scenario: Scenario
     world: KnownWorld
@@ -27,6 +29,8 @@ class RunContext:
     support_mpc: SupportMpc
     rng: np.random.Generator
     planner: LocalPlanner  # solves the support MPCs: here, or shared with a helper process
+    inspections: dict[str, np.ndarray] = field(default_factory=dict)  # support -> (n, 3)
+    routes: RouteMap | None = None  # None without inspections
 
 
 def build_run_context(
@@ -51,6 +55,7 @@ def build_run_context(
     planner = (
         LocalPlanner(mpc, observable) if helper is None else HelperPlanner(mpc, observable, helper)
     )
+    inspections = {i.vehicle: np.array(i.waypoints_m, dtype=float) for i in scn.task.inspections}
     context = RunContext(
         scn,
         world,
@@ -60,6 +65,8 @@ def build_run_context(
         mpc,
         np.random.default_rng(seed),
         planner,
+        inspections,
+        route_map(world) if inspections else None,
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),

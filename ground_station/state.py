@@ -6,12 +6,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ground_station.roles.assignment import Allocation
+
 
 @dataclass
 class StationState:
     """The estimates (xhat of the work UAV, yhat_n of each support), the current work waypoint
-    k, the displacement each vehicle was last commanded, and each support MPC's last path (its
-    next warm start)."""
+    k, the displacement each vehicle was last commanded, each support MPC's last path (its
+    next warm start) and each support's role."""
 
     xhat: np.ndarray
     yhat: dict[str, np.ndarray]
@@ -21,6 +23,7 @@ class StationState:
     warm: dict[str, np.ndarray] = field(default_factory=dict)
     completed: bool = False
     blind_cycles: int = 0  # consecutive cycles with no estimate of the work UAV, up to now
+    allocation: Allocation = field(default_factory=Allocation)  # each support's role
 
     def forget(self, support: str) -> None:
         """Drop what was carried for a support that fell silent and is back."""

@@ -30,6 +30,7 @@ from ground_station.links.vehicle_links import VehicleLinks
 from ground_station.localize import SupportReport, gnss_fix, reports_from_messages
 from ground_station.preflight import arm_all, connect, upload_missions
 from ground_station.records import SNAPSHOT_EVERY, GSnapshots, RunRecords
+from ground_station.roles.allocation import inspections_left
 from ground_station.run_context import RunContext, build_run_context, require_known_world
 from ground_station.state import StationState
 from ground_station.support_mpc.sharing import MpcHelper
@@ -69,6 +70,13 @@ class StationConfig:
         if self.speedup is None:
             return self.link_loss_s
         return max(self.link_loss_s, self.link_loss_wall_s * self.speedup)
+
+
+def _all_done(state: StationState, context: RunContext | None) -> bool:
+    """The work UAV's task is complete and no support has inspection waypoints left."""
+    return state.completed and not (
+        context is not None and inspections_left(state.allocation, context)
+    )
 
 
 class GroundStation:
@@ -139,8 +147,10 @@ class GroundStation:
         return self.context, state
 
     def _fly(self, context: RunContext, state: StationState) -> float | None:
-        """Control cycles until the work UAV completes its task (its time) or the timeout."""
+        """Control cycles until the work UAV completes its task and the supports their
+        inspections, or the timeout; the time the work UAV's task was complete."""
         self.clock.begin_flight()
+        completion: float | None = None  # when the work UAV completed its task
         pending = self._start_step(self.clock.next_step())
         self.links.flush_all()
         while pending is not None:
@@ -157,14 +167,25 @@ class GroundStation:
             output = complete_cycle(state, decision, context)  # the supports' MPCs are solved
             self._command_supports(state, output)
             cycle_time_s = self.clock.time_s
+            done = _all_done(state, context)
+            if state.completed and completion is None and not done:  # inspections go on
+                completion = self._announce_completion()
             # the next tick goes out now: the vehicles step while this cycle is written down
-            pending = None if state.completed else self._start_step(work_step, work_ticked=True)
+            pending = None if done else self._start_step(work_step, work_ticked=True)
             self.links.flush_all()
             self._record(context, state, output, cycle_time_s, self._ages_ms(reports))
-            if state.completed:
-                self.links.announce(f"Mission complete at {self.clock.time_s:.1f} s")
-                return self.clock.time_s
-        return None
+            if done:
+                if completion is None:
+                    completion = self._announce_completion()
+                if context.inspections:
+                    self.links.announce(f"Inspections complete at {cycle_time_s:.1f} s")
+                return completion
+        return completion
+
+    def _announce_completion(self) -> float:
+        """Say the work UAV's task is complete (now); its time."""
+        self.links.announce(f"Mission complete at {self.clock.time_s:.1f} s")
+        return self.clock.time_s
 
     def _work_fix(self) -> np.ndarray | None:
         """The work UAV's own 3-D fix of this cycle (ENU), where the roles are dynamic (the
@@ -212,7 +233,7 @@ class GroundStation:
         if decision.arrived is not None and not state.completed:
             links.queue_for(mission_set_current(work.system_id, state.k + 1), work)
             links.announce(f"Work UAV reached waypoint {decision.arrived + 1}")
-        step = None if state.completed else self.clock.next_step()
+        step = None if _all_done(state, self.context) else self.clock.next_step()
         if step is not None and step.tick is not None:
             links.queue_for(step.tick, work)
         links.flush(work)

@@ -30,6 +30,7 @@ SHORT_NAMES = {  # the names the docstrings use for the project's packages
     "studies": "mission.studies",
     "viewer": "mission.viewer",
     "ground_station": "ground_station",
+    "support_mpc": "ground_station.support_mpc",
     "vehicle_sim": "vehicle_sim",
 }
 

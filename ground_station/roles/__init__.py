@@ -1,1 +1,1 @@
-"""Who does what in the formation (issue 33). Imports: config, world, ground_station."""
+"""Who flies in the formation, who inspects. Imports: config, world, ground_station, support_mpc."""

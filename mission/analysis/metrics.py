@@ -17,7 +17,6 @@ import os
 import re
 from collections import defaultdict
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -28,8 +27,9 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.analysis.safety import safety_metrics
 from mission.analysis.spread import spread
+from mission.analysis.trace import RunTrace
 from mission.analysis.tracking import tracking_metrics
-from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate, truth_time
+from mission.analysis.truth import TimesyncReply, clock_offsets, truth_time
 from mission.config.settings import Scenario
 from mission.link.fast_decode import FastDecoder
 from mission.link.vehicle_events import parse_event
@@ -51,52 +51,6 @@ _WANTED_IDS = frozenset(
         mavlink2.MAVLINK_MSG_ID_TIMESYNC,
     }
 )
-
-
-@dataclass
-class RunTrace:
-    """What a ground station's tlog says about a run, in simulated seconds."""
-
-    truth: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
-    estimates: dict[float, np.ndarray] = field(default_factory=dict)  # the work UAV's, by time
-    # every vehicle's belief (LOCAL_POSITION_NED), setpoints and the estimates sent before them
-    beliefs: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
-    setpoints: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
-    sent_estimates: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
-    cycles: set[float] = field(default_factory=set)  # times of the work UAV's setpoints
-    ticks: set[float] = field(default_factory=set)
-    completion: float | None = None
-    link_events: list[dict[str, Any]] = field(default_factory=list)
-    contacts: list[dict[str, Any]] = field(default_factory=list)  # as the vehicles reported them
-    events: list[dict[str, Any]] = field(default_factory=list)  # faults, sets, failures
-    stopped: str | None = None  # the ground station's word that it stopped the run
-    max_gap_s: float = 1.0  # truth is interpolated between samples at most this far apart
-
-    @property
-    def supports(self) -> list[int]:
-        """System ids of the support vehicles (the work UAV is system 1)."""
-        return sorted({s for s, _ in self.truth if s != 1})
-
-    @property
-    def mode(self) -> str:
-        """``lockstep`` (the ground station sent clock ticks) or ``realtime``."""
-        return "lockstep" if self.ticks else "realtime"
-
-    @property
-    def cycle_times(self) -> list[float]:
-        """The control cycles' times (one setpoint for the work UAV each)."""
-        return sorted(self.cycles)
-
-    def track(self, system: int) -> tuple[np.ndarray, np.ndarray]:
-        """(times, positions) of one vehicle's truth."""
-        times = sorted(t for s, t in self.truth if s == system)
-        points = [self.truth[(system, t)] for t in times]
-        return np.array(times), np.array(points).reshape(-1, 3)
-
-    def truth_at(self, system: int, times: list[float]) -> tuple[np.ndarray, np.ndarray]:
-        """One vehicle's truth at these times, and which of them are known."""
-        track_times, positions = self.track(system)
-        return interpolate(track_times, positions, np.array(times), self.max_gap_s)
 
 
 def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
@@ -124,25 +78,20 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     sample_s = max(scenario.control.t_cont_s, 1.0 / scenario.vehicle.sensor_hz)
     trace = RunTrace(max_gap_s=2 * sample_s)
     pending_estimate: tuple[float, np.ndarray] | None = None
-    pending_truth: dict[int, np.ndarray] = {}  # a vehicle's SIM_STATE awaiting its step's stamp
-    pending_belief: dict[int, np.ndarray] = {}  # its LOCAL_POSITION_NED, likewise
-    stamped: list[tuple[int, int, np.ndarray]] = []  # (system, stamp in usec, position)
-    stamped_beliefs: list[tuple[int, int, np.ndarray]] = []
+    samples = _StepSamples()
     replies: list[TimesyncReply] = []
     for message in messages:
         kind = message.get_type()
         t = round(message._timestamp - epoch, 3)
         source = message.get_srcSystem()
         if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
-            pending_truth[source] = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
+            truth = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
+            samples.pending[TRUTH][source] = truth
         elif kind == "LOCAL_POSITION_NED" and source != GCS_SYSTEM_ID:
-            pending_belief[source] = ned_to_enu(np.array([message.x, message.y, message.z]))
+            belief = ned_to_enu(np.array([message.x, message.y, message.z]))
+            samples.pending[BELIEF][source] = belief
         elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
-            stamp = int(message.time_unix_usec)
-            if source in pending_truth:
-                stamped.append((source, stamp, pending_truth.pop(source)))
-            if source in pending_belief:
-                stamped_beliefs.append((source, stamp, pending_belief.pop(source)))
+            samples.stamp(source, int(message.time_unix_usec))
         elif kind == "STATUSTEXT" and source != GCS_SYSTEM_ID:
             contact = _CONTACT.match(message.text)
             if contact:
@@ -177,11 +126,29 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             trace.link_events.append({"t": t, "event": message.text})
     offsets = {} if trace.ticks else clock_offsets(replies)
     epoch_usec = round(epoch * 1e6)
-    for samples, into in ((stamped, trace.truth), (stamped_beliefs, trace.beliefs)):
-        for system, stamp, position in samples:
+    for kind, into in ((TRUTH, trace.truth), (BELIEF, trace.beliefs)):
+        for system, stamp, position in samples.stamped[kind]:
             if trace.ticks or system in offsets:
                 into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
     return trace
+
+
+TRUTH, BELIEF = "truth", "belief"
+
+
+class _StepSamples:
+    """Each vehicle's truth (SIM_STATE) and belief (LOCAL_POSITION_NED) of a step, held until
+    that step's SYSTEM_TIME marker stamps them: (system, stamp in usec, position)."""
+
+    def __init__(self) -> None:
+        self.pending: dict[str, dict[int, np.ndarray]] = {TRUTH: {}, BELIEF: {}}
+        self.stamped: dict[str, list[tuple[int, int, np.ndarray]]] = {TRUTH: [], BELIEF: []}
+
+    def stamp(self, system: int, usec: int) -> None:
+        """The step's marker: what ``system`` sent before it is stamped with ``usec``."""
+        for kind, waiting in self.pending.items():
+            if system in waiting:
+                self.stamped[kind].append((system, usec, waiting.pop(system)))
 
 
 def _contact_event(system: int, match: re.Match) -> dict[str, Any]:

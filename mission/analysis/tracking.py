@@ -17,15 +17,11 @@ are interpolated to the cycles' times, which can mix in an estimate's jump.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from mission.analysis.spread import spread
+from mission.analysis.trace import RunTrace
 from mission.analysis.truth import interpolate
-
-if TYPE_CHECKING:
-    from mission.analysis.metrics import RunTrace
 
 WORK_SYSTEM = 1
 

@@ -59,10 +59,12 @@ def realtime_speedup(args: argparse.Namespace) -> float | None:
 def preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts: the structure's
     mesh (loading the known world), every vehicle's waypoint file (the work UAV's the
-    scenario's path), and the supports' own inspection waypoints against the structure."""
+    scenario's path), the supports' own inspection waypoints against the structure, and,
+    with dynamic roles, that a released support can be recalled in time."""
     from mission.link.plan_check import (
         check_inspections_placed,
         check_plan_files,
+        check_recall_in_time,
         check_work_plan_matches,
     )
     from mission.link.plan_files import vehicle_names
@@ -73,6 +75,7 @@ def preflight(scenario) -> None:
     check_plan_files(world, Path(scenario.task.waypoints_dir), names)
     check_work_plan_matches(world, Path(scenario.task.waypoints_dir))
     check_inspections_placed(world)
+    check_recall_in_time(world)
 
 
 def check_figure_path(path: Path, flag: str, made: Path | None = None) -> None:

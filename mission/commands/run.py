@@ -92,49 +92,20 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from mission.config.scenario import load_scenario
-    from mission.runs.orchestrator import RunFailed, RunOptions, run_mission
+    from mission.runs.orchestrator import RunFailed, run_mission
 
     if args.exit_with_parent:
         from mission.procs.cli_common import die_with_parent
 
         die_with_parent()
     check_seed(args.seed)
-    if not (0 <= args.stall_s < float("inf")):
-        raise InputError(
-            "command line", "--stall-s", f"must be finite and >= 0, not {args.stall_s}"
-        )
     speedup = realtime_speedup(args)
     scenario = load_scenario(args.scenario)
     preflight(scenario)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
     check_output_dir(out, "--out")
-    if args.signing_key is not None:
-        from mission.link.signing import read_signing_key
-
-        read_signing_key(args.signing_key)  # a bad key fails here, before anything starts
-    if args.observer is not None:
-        from mission.link.mavlink_udp import parse_address
-
-        try:
-            parse_address(args.observer, "--observer")
-        except ValueError as error:
-            raise InputError("command line", "--observer", str(error)) from None
-    link = link_settings(args)
-    options = RunOptions(
-        args.scenario,
-        args.method,
-        args.seed,
-        out,
-        speedup,
-        args.signing_key.resolve() if args.signing_key else None,
-        args.observer,
-        link,
-        args.mpc_helper,
-        args.process_start,
-        args.g_snapshots,
-        args.stall_s,
-    )
+    options = _run_options(args, out, speedup)
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     live = None
     try:
@@ -152,6 +123,40 @@ def run(args: argparse.Namespace) -> int:
         if live is not None:
             live.close()
     return 0
+
+
+def _run_options(args: argparse.Namespace, out: Path, speedup: float | None):
+    """The run's options from the command line, each flag checked before anything starts."""
+    from mission.runs.orchestrator import RunOptions
+
+    if not (0 <= args.stall_s < float("inf")):
+        problem = f"must be finite and >= 0, not {args.stall_s}"
+        raise InputError("command line", "--stall-s", problem)
+    if args.signing_key is not None:
+        from mission.link.signing import read_signing_key
+
+        read_signing_key(args.signing_key)  # a bad key fails here, before anything starts
+    if args.observer is not None:
+        from mission.link.mavlink_udp import parse_address
+
+        try:
+            parse_address(args.observer, "--observer")
+        except ValueError as error:
+            raise InputError("command line", "--observer", str(error)) from None
+    return RunOptions(
+        args.scenario,
+        args.method,
+        args.seed,
+        out,
+        speedup,
+        args.signing_key.resolve() if args.signing_key else None,
+        args.observer,
+        link_settings(args),
+        args.mpc_helper,
+        args.process_start,
+        args.g_snapshots,
+        args.stall_s,
+    )
 
 
 def _live_view(choice: str, out: Path, scenario):

@@ -3,6 +3,7 @@ where it can (:mod:`ground_station.roles`)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -16,14 +17,43 @@ class RoleSettings:
     GNSS fix ignored. ``dynamic``: the ground station also judges the work UAV's own fix each
     cycle and fuses it when it is trustworthy: a 3-D fix where the map G (learned, or the sky's
     prediction) expects at most ``own_fix_max_sigma_m``, and, where the supports give a
-    relative estimate, within ``own_fix_agreement_sigmas`` standard deviations of it."""
+    relative estimate, within ``own_fix_agreement_sigmas`` standard deviations of it.
+
+    With ``dynamic`` the supports also inspect for themselves when the formation can spare
+    them (:mod:`ground_station.roles.allocation`): all but ``keep_in_formation`` are released
+    once the work UAV's own fix is expected trustworthy along its path for at least
+    ``release_clear_s`` of its flight, and recalled once it is expected for less than
+    ``recall_clear_s`` (the hysteresis: release needs the longer look ahead). A released
+    support has reached an inspection waypoint within ``inspection_tol_m``. With ``fixed``,
+    the supports fly their inspections once the work UAV's task is complete."""
 
     policy: Literal["fixed", "dynamic"]
     own_fix_max_sigma_m: float
     own_fix_agreement_sigmas: float
+    release_clear_s: float
+    recall_clear_s: float
+    keep_in_formation: int
+    inspection_tol_m: float
 
     def __post_init__(self) -> None:
-        _positive(self, "own_fix_max_sigma_m", "own_fix_agreement_sigmas")
+        _positive(
+            self,
+            "own_fix_max_sigma_m",
+            "own_fix_agreement_sigmas",
+            "release_clear_s",
+            "recall_clear_s",
+            "inspection_tol_m",
+        )
+        for name in ("release_clear_s", "recall_clear_s", "inspection_tol_m"):
+            _require(math.isfinite(getattr(self, name)), name, "must be finite")
+        _require(
+            self.release_clear_s > self.recall_clear_s,
+            "release_clear_s",
+            f"{self.release_clear_s:g} s must exceed recall_clear_s ({self.recall_clear_s:g} s): "
+            "the hysteresis is the wrong way round (a support would be recalled as soon as it "
+            "is released)",
+        )
+        _require(self.keep_in_formation >= 0, "keep_in_formation", "must be >= 0")
 
 
 @dataclass(frozen=True)
@@ -36,6 +66,15 @@ class Inspection:
 
     def __post_init__(self) -> None:
         _require(bool(self.waypoints_m), "waypoints_m", "needs at least one waypoint")
+
+
+def check_roles(roles: RoleSettings, supports: int) -> None:
+    """The formation kept while supports inspect has no more supports than the scenario."""
+    _require(
+        roles.keep_in_formation <= supports,
+        "roles.keep_in_formation",
+        f"{roles.keep_in_formation} is more than the scenario's {supports} supports",
+    )
 
 
 def check_inspections(inspections: list[Inspection], supports: int, workspace) -> None:

@@ -18,7 +18,12 @@ from mission.config.errors import FieldProblem
 from mission.config.fault_settings import Fault, check_faults
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
-from mission.config.role_settings import Inspection, RoleSettings, check_inspections
+from mission.config.role_settings import (
+    Inspection,
+    RoleSettings,
+    check_inspections,
+    check_roles,
+)
 from mission.config.wind_settings import WindSettings
 
 Vec3 = tuple[float, float, float]
@@ -359,6 +364,7 @@ class Scenario:
             inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))
             _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")
         check_inspections(self.task.inspections, self.task.supports, self.world.workspace)
+        check_roles(self.roles, self.task.supports)
 
     def _check_margins(self) -> None:
         """A margin, where there is one, leaves room for the bodies it keeps apart."""

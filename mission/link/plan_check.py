@@ -130,3 +130,38 @@ def check_work_plan_matches(world: KnownWorld, directory: Path) -> None:
         shown = [round(float(v), 2) for v in flown[i]]
         problem = f"{shown} (ENU), not task.work_waypoints_m[{i}] {[float(v) for v in wanted[i]]}"
         raise InputError(str(path), f"item {i + 1}", problem + again)
+
+
+def check_recall_in_time(world: KnownWorld) -> None:
+    """With dynamic roles, a released support can be back in the formation in time: its
+    longest flight (around the structure, at its speed limit) from one of its inspection
+    waypoints to its planned waypoint where the work UAV's path enters the sky's shadow is
+    at most ``roles.recall_clear_s``; else InputError naming that field and the flight."""
+    from mission.link.plan_files import read_vehicle_waypoints
+    from mission.world.routes import route_map
+
+    scenario = world.scenario
+    roles = scenario.roles
+    if roles.policy != "dynamic" or not scenario.task.inspections:
+        return
+    work = np.asarray(scenario.task.work_waypoints_m, dtype=float)
+    sigma = world.gnss.sigma0(work)
+    trusted = np.isfinite(sigma) & (sigma <= roles.own_fix_max_sigma_m)
+    entries = [j for j in range(len(work)) if not trusted[j] and (j == 0 or trusted[j - 1])]
+    if not entries:
+        return
+    routes = route_map(world)
+    speed = scenario.control.s_max_support_m_s
+    for inspection in scenario.task.inspections:
+        formation = read_vehicle_waypoints(scenario, inspection.vehicle)[entries]
+        lengths = routes.lengths(np.asarray(inspection.waypoints_m, dtype=float), formation)
+        i, j = np.unravel_index(int(np.argmax(lengths)), lengths.shape)
+        flight_s = float(lengths[i, j]) / speed
+        if flight_s > roles.recall_clear_s:
+            problem = (
+                f"{roles.recall_clear_s:g} s is less than {inspection.vehicle}'s flight back from "
+                f"its inspection waypoint {i + 1} to the formation where the work UAV enters the "
+                f"shadow (work waypoint {entries[j] + 1}): {flight_s:.1f} s at {speed:g} m/s; it "
+                "could not be recalled in time"
+            )
+            raise InputError(scenario.source, "roles.recall_clear_s", problem)

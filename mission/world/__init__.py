@@ -1,1 +1,1 @@
-"""World model: structure, rays, sky, GNSS, camera, frames, grid, zones, wind. Imports: config."""
+"""World model: structure, sky, GNSS, camera, frames, grid, routes, zones, wind. Imports: config."""

@@ -40,6 +40,12 @@ OVERLAP = (
 
 INSPECTIONS = "task:\n  inspections:\n    - {vehicle: %s, waypoints_m: [%s]}\n"
 
+HYSTERESIS = "roles: {policy: dynamic, release_clear_s: 30, recall_clear_s: 40}\n"
+LATE_RECALL = (
+    "roles: {policy: dynamic, release_clear_s: 3, recall_clear_s: 2}\n"
+    + INSPECTIONS % ("support-1", "[0.0, -16.0, 3.0]")
+)
+
 NEW_PATH = "task: {work_waypoints_m: [[-12.0, -3.0, 7.0], [-12.0, 3.0, 7.0]]}\n"
 
 FILE_CASES = [
@@ -64,6 +70,21 @@ FILE_CASES = [
         "yaml-inspection-of-no-such-support",
         lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-7", "[0.0, -12.0, 7.0]")))],
         ["bad.yaml", "task.inspections[0].vehicle", "not a support of this scenario"],
+    ),
+    (
+        "yaml-roles-hysteresis-wrong-way-round",
+        lambda t: [*RUN, str(scenario_file(t, HYSTERESIS))],
+        ["bad.yaml", "roles.release_clear_s", "wrong way round"],
+    ),
+    (
+        "yaml-roles-recall-too-late",
+        lambda t: [*RUN, str(scenario_file(t, LATE_RECALL))],
+        ["bad.yaml", "roles.recall_clear_s", "support-1", "could not be recalled in time"],
+    ),
+    (
+        "yaml-roles-keep-more-than-the-supports",
+        lambda t: [*RUN, str(scenario_file(t, "roles: {keep_in_formation: 4}\n"))],
+        ["bad.yaml", "roles.keep_in_formation", "more than the scenario's 3 supports"],
     ),
     # --- safety margins ----------------------------------------------------------------
     (

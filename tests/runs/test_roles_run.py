@@ -1,6 +1,8 @@
-"""Dynamic roles in a real run (issue 33): on the piers scenario the ground station uses the
-work UAV's own fix in the open (most of its first 90 s, at the west pier and the deck's south
-edge), each where G expects at most 0.3 m, and the summary counts the verdicts."""
+"""Dynamic roles in a real run (issue 33), the first 120 s of the piers scenario: the ground
+station uses the work UAV's own fix in the open (at the west pier and the deck's south edge),
+each where G expects at most 0.3 m, and the summary counts the verdicts; it releases supports
+to their inspections while the path ahead is open, and has them all back in the formation
+before the work UAV's fix fails under the deck."""
 
 from __future__ import annotations
 
@@ -10,20 +12,30 @@ import pytest
 
 from tests.processes import mission
 
+OFF_SKY = ("no fix", "shadow", "map")  # the verdicts of a work UAV where its fix fails
+
 
 @pytest.mark.slow
-def test_in_the_open_the_work_uav_is_localized_by_its_own_fix_too(tmp_path):
+def test_in_the_open_supports_inspect_and_are_back_before_the_shadow(tmp_path):
     scenario = tmp_path / "piers-dynamic.yaml"
     scenario.write_text(
-        "extends: piers\nname: piers-dynamic\nroles: {policy: dynamic}\nrun: {timeout_s: 90}\n"
+        "extends: piers\nname: piers-dynamic\nroles: {policy: dynamic}\nrun: {timeout_s: 120}\n"
     )
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     records = [json.loads(line) for line in (tmp_path / "run" / "records.jsonl").open()]
     verdicts = [r["own_fix"] for r in records]
     used = [v for v in verdicts if v["used"]]
-    assert len(used) > len(records) / 2  # the west pier's face and the south edge: open sky
+    assert len(used) > len(records) / 3  # the west pier's face and the south edge: open sky
     assert all(v["sigma_m"] <= 0.3 for v in used)
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     counts = summary["diagnostics"]["own_fix_cycles"]
     assert counts["used"] == len(used) and sum(counts.values()) == len(records)
+
+    roles = [r["roles"]["roles"] for r in records]
+    assert any("inspecting" in r.values() for r in roles[:10])  # released at the start
+    assert any(n > 0 for n in records[-1]["roles"]["next_inspection"].values())  # and inspected
+    assert sum(r["own_fix"]["reason"] == "no fix" for r in records) > 10  # under the deck
+    for record, role in zip(records, roles):
+        if record["own_fix"]["reason"] in OFF_SKY or record["blind"]:
+            assert set(role.values()) == {"formation"}, (record["t"], role)  # recalled in time

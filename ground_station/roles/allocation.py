@@ -1,0 +1,210 @@
+"""Task allocation: which supports the formation needs now, and where the others fly.
+
+Each support is in one of three roles:
+
+- ``formation``: planned by its MPC around the work UAV (the paper's role);
+- ``inspecting``: flying a route (:mod:`ground_station.roles.routes`) to its next inspection
+  waypoint (``task.inspections``), then the next, until it has reached them all;
+- ``returning``: flying a route back to its formation waypoint; within ``HANDOVER_M`` of it
+  (or at the route's end) its MPC takes it again.
+
+With ``roles.policy: dynamic``, each cycle the work UAV's path ahead is looked at
+(:mod:`ground_station.roles.lookahead`): where its own fix is expected trustworthy for
+``release_clear_s`` or more (or to the end of its task), supports with inspections left are
+released, all but ``keep_in_formation`` (the farthest from the work UAV first); where it is
+expected for less than ``recall_clear_s``, every inspecting support is recalled. Between the
+two nothing changes: a path along a shadow's edge recalls once and releases again only with
+``release_clear_s`` of open sky ahead (the hysteresis). With ``fixed`` (the paper), supports
+go inspecting only once the work UAV's task is complete. A support that has reached all its
+inspection waypoints returns to the formation (or, the task complete, holds there).
+
+A routed support steps toward its route's next corner by at most its reach; where that step
+would bring it within the separation (widened by two estimates' allowance) of another UAV's
+estimate, and closer, it steps straight away from that UAV instead (it gives way: the work UAV
+and the formation's MPCs plan around it from its estimate and its predicted route).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ground_station.roles.assignment import (
+    FORMATION,
+    INSPECTING,
+    RETURNING,
+    Allocation,
+    SupportRole,
+)
+from ground_station.roles.lookahead import clear_ahead_s
+from ground_station.run_context import RunContext
+from ground_station.state import StationState
+from ground_station.support_mpc.mpc import SupportPlan
+
+HANDOVER_M = 2.0  # a returning support this close to its formation waypoint rejoins
+CORNER_TOL_M = 0.3  # a route's corner (not an inspection waypoint) is passed this close
+
+
+def inspections_left(allocation: Allocation, context: RunContext) -> bool:
+    """Whether a support has inspection waypoints it has not reached."""
+    return any(
+        allocation.supports.get(n, SupportRole()).next_inspection < len(points)
+        for n, points in context.inspections.items()
+    )
+
+
+def allocate(state: StationState, context: RunContext, allocation: Allocation) -> None:
+    """This cycle's roles (``allocation`` updated in place): progress along the routes, then
+    release and recall. Without inspections in the scenario nothing happens."""
+    if not context.inspections:
+        return
+    for name in context.inspections:
+        allocation.supports.setdefault(name, SupportRole())
+    _progress(state, context, allocation)
+    roles = context.scenario.roles
+    if roles.policy == "dynamic" and not state.completed:
+        allocation.clear_s = clear_ahead_s(
+            state.xhat,
+            state.k,
+            context.work_waypoints,
+            context.g,
+            roles.own_fix_max_sigma_m,
+            context.scenario.control.s_max_work_m_s,
+            roles.release_clear_s,
+        )
+    else:
+        allocation.clear_s = math.inf if state.completed else 0.0
+    if allocation.clear_s < roles.recall_clear_s:
+        for name, support in allocation.supports.items():
+            if support.role == INSPECTING:
+                _set(allocation, name, RETURNING, _route_home(state, context, name))
+    elif allocation.clear_s >= roles.release_clear_s:
+        _release(state, context, allocation)
+
+
+def _release(state: StationState, context: RunContext, allocation: Allocation) -> None:
+    keep = 0 if state.completed else context.scenario.roles.keep_in_formation
+    limit = len(state.yhat) - keep
+    out = sum(1 for s in allocation.supports.values() if s.role == INSPECTING)
+    candidates = [
+        n
+        for n, s in allocation.supports.items()
+        if s.role != INSPECTING and s.next_inspection < len(context.inspections[n])
+    ]
+    candidates.sort(key=lambda n: (-float(np.linalg.norm(state.yhat[n] - state.xhat)), n))
+    for name in candidates[: max(0, limit - out)]:
+        _set(allocation, name, INSPECTING, _route_to_inspection(state, context, allocation, name))
+
+
+def _progress(state: StationState, context: RunContext, allocation: Allocation) -> None:
+    """Corners passed, inspection waypoints reached, returns completed."""
+    tol = context.scenario.roles.inspection_tol_m
+    for name, support in allocation.supports.items():
+        if support.role == FORMATION:
+            continue
+        yhat = state.yhat[name]
+        while support.route is not None and len(support.route) > 1:
+            if np.linalg.norm(support.route[0] - yhat) >= CORNER_TOL_M:
+                break
+            support.route = support.route[1:]
+        waypoints = context.inspections[name]
+        if support.role == INSPECTING and support.next_inspection < len(waypoints):
+            if np.linalg.norm(waypoints[support.next_inspection] - yhat) < tol:
+                support.next_inspection += 1
+                if support.next_inspection < len(waypoints):
+                    support.route = _route_to_inspection(state, context, allocation, name)
+                elif state.completed:  # all done, the task too: it holds where it is
+                    support.route = np.array([yhat])
+                else:
+                    _set(allocation, name, RETURNING, _route_home(state, context, name))
+        elif support.role == RETURNING:
+            home = _formation_waypoint(state, context, name)
+            if np.linalg.norm(home - yhat) < HANDOVER_M or len(support.route) <= 1:
+                _set(allocation, name, FORMATION, None)
+                state.warm.pop(name, None)  # its MPC starts afresh from where it is
+
+
+def _set(allocation: Allocation, name: str, role: str, route: np.ndarray | None) -> None:
+    support = allocation.supports[name]
+    if support.role != role:
+        allocation.switches += 1
+    support.role, support.route = role, route
+
+
+def _formation_waypoint(state: StationState, context: RunContext, name: str) -> np.ndarray:
+    waypoints = context.support_waypoints[name]
+    return waypoints[min(state.k, len(waypoints) - 1)]
+
+
+def _route_to_inspection(state, context, allocation, name) -> np.ndarray:
+    goal = context.inspections[name][allocation.supports[name].next_inspection]
+    return _routed(context, state.yhat[name], goal)
+
+
+def _route_home(state: StationState, context: RunContext, name: str) -> np.ndarray:
+    return _routed(context, state.yhat[name], _formation_waypoint(state, context, name))
+
+
+def _routed(context: RunContext, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
+    """The route's corners after ``start`` (the straight way where no free way is found)."""
+    assert context.routes is not None
+    route = context.routes.route(start, goal)
+    return np.array([goal]) if route is None else route[1:]
+
+
+def routed_plans(state: StationState, context: RunContext, allocation: Allocation):
+    """{name: plan} of every support off the formation: its route's next steps (the first is
+    its command), or, where that step would crowd another UAV, a step away from it."""
+    control = context.scenario.control
+    reach = control.s_max_support_m_s * control.t_cont_s
+    horizon = control.horizon_steps
+    plans = {}
+    for name, support in allocation.supports.items():
+        if support.role == FORMATION:
+            continue
+        yhat = state.yhat[name]
+        path = _along(yhat, support.route, reach, horizon)
+        away = _give_way(state, context, name, path[0])
+        if away is not None:
+            path = np.repeat(away[None], horizon, axis=0)
+        blocked = np.zeros(horizon, dtype=bool)
+        plans[name] = SupportPlan(path, support.role.upper(), 0.0, blocked, False, np.zeros(0))
+    return plans
+
+
+def _along(start: np.ndarray, route: np.ndarray | None, reach: float, steps: int) -> np.ndarray:
+    """``steps`` positions a reach apart along the route's corners from ``start``."""
+    corners = np.vstack([start[None], route]) if route is not None else start[None]
+    legs = np.linalg.norm(np.diff(corners, axis=0), axis=1)
+    ends = np.concatenate([[0.0], np.cumsum(legs)])
+    arcs = np.minimum(reach * np.arange(1, steps + 1), ends[-1])
+    return np.column_stack([np.interp(arcs, ends, corners[:, a]) for a in range(3)])
+
+
+def _give_way(state, context, name, command) -> np.ndarray | None:
+    """A step straight away from the nearest UAV whose separation ``command`` would break
+    (and come closer), or None."""
+    control = context.scenario.control
+    if control.min_separation_m <= 0:
+        return None
+    needed = control.min_separation_m + 2 * control.estimate_allowance_m
+    yhat = state.yhat[name]
+    others = [state.xhat, *(p for n, p in state.yhat.items() if n != name)]
+    crowded = [
+        o
+        for o in others
+        if np.linalg.norm(command - o) < needed
+        and np.linalg.norm(command - o) < np.linalg.norm(yhat - o)
+    ]
+    if not crowded:
+        return None
+    nearest = min(crowded, key=lambda o: float(np.linalg.norm(yhat - o)))
+    away = yhat - nearest
+    reach = control.s_max_support_m_s * control.t_cont_s
+    step = yhat + away / max(float(np.linalg.norm(away)), 1e-9) * reach
+    assert context.routes is not None
+    after, now = context.routes.proximity.clearance(np.vstack([step, yhat]))
+    if after < context.routes.margin_m and after < now:  # away would be toward the structure
+        return yhat.copy()
+    return step

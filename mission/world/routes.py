@@ -1,0 +1,123 @@
+"""Routes around the structure for a support that leaves the formation or comes back to it.
+
+The formation's MPC plans a support locally, around the work UAV; a support flying to its own
+inspection waypoint (on the far side of a pier, on top of the deck) needs a way around the
+structure first. The map G's voxel grid is the graph: a voxel is free where its centre is at
+least ``margin_m`` from the structure and the ground, and free voxels that touch (26
+neighbours) are joined by their centres' distance. Dijkstra's algorithm (scipy's csgraph)
+gives the shortest way; the voxel path is then pulled straight: each corner is skipped where
+the segment past it keeps the margin (sampled every quarter voxel).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from mission.world.grid import VoxelGrid
+from mission.world.model import KnownWorld
+from mission.world.proximity import StructureProximity
+
+NEIGHBOURS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)])
+
+
+class RouteMap:
+    """Shortest routes between points through the free voxels of ``grid``."""
+
+    def __init__(self, grid: VoxelGrid, proximity: StructureProximity, margin_m: float) -> None:
+        self.grid, self.proximity, self.margin_m = grid, proximity, margin_m
+        centres = grid.centers().reshape(-1, 3)
+        self.free = proximity.clearance(centres) >= margin_m
+        self.centres = centres
+        self.graph = self._graph()
+
+    def _graph(self):
+        shape = np.array(self.grid.shape)
+        index = np.arange(self.grid.n_voxels).reshape(self.grid.shape)
+        rows, cols, weights = [], [], []
+        for offset in NEIGHBOURS:
+            low, high = np.maximum(0, -offset), shape - np.maximum(0, offset)
+            here = index[low[0] : high[0], low[1] : high[1], low[2] : high[2]].ravel()
+            shifted = index[
+                low[0] + offset[0] : high[0] + offset[0],
+                low[1] + offset[1] : high[1] + offset[1],
+                low[2] + offset[2] : high[2] + offset[2],
+            ].ravel()
+            keep = self.free[here] & self.free[shifted]
+            rows.append(here[keep])
+            cols.append(shifted[keep])
+            weights.append(np.full(int(keep.sum()), self.grid.voxel_m * np.linalg.norm(offset)))
+        n = self.grid.n_voxels
+        return coo_matrix(
+            (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
+        ).tocsr()
+
+    def cell_of(self, point: np.ndarray) -> int:
+        """The free voxel nearest ``point`` (its own where that one is free)."""
+        index = self.grid.index_of(np.asarray(point, dtype=float)[None])[0]
+        cell = int(np.ravel_multi_index(tuple(index), self.grid.shape))
+        if self.free[cell]:
+            return cell
+        free = np.flatnonzero(self.free)
+        gaps = np.linalg.norm(self.centres[free] - np.asarray(point, dtype=float), axis=1)
+        return int(free[np.argmin(gaps)])
+
+    def lengths(self, sources: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """(sources, targets): the length of the shortest voxel way between each pair, from
+        each point to its free voxel's centre and on (infinity where none joins them)."""
+        sources, targets = np.atleast_2d(sources), np.atleast_2d(targets)
+        start_cells = [self.cell_of(p) for p in sources]
+        end_cells = [self.cell_of(p) for p in targets]
+        through = dijkstra(self.graph, indices=start_cells)[:, end_cells]
+        lead_in = np.linalg.norm(self.centres[start_cells] - sources, axis=1)
+        lead_out = np.linalg.norm(self.centres[end_cells] - targets, axis=1)
+        return through + lead_in[:, None] + lead_out[None, :]
+
+    def route(self, start: np.ndarray, goal: np.ndarray) -> np.ndarray | None:
+        """Corners from ``start`` to ``goal`` (both included), pulled straight; None where no
+        free way joins them."""
+        start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+        if self._clear(start, goal):
+            return np.vstack([start, goal])
+        first, last = self.cell_of(start), self.cell_of(goal)
+        _, previous = dijkstra(self.graph, indices=first, return_predecessors=True)
+        if first != last and previous[last] < 0:
+            return None
+        cells = [last]
+        while cells[-1] != first:
+            cells.append(int(previous[cells[-1]]))
+        corners = np.vstack([start, self.centres[cells[::-1]], goal])
+        return self._pulled(corners)
+
+    def _pulled(self, corners: np.ndarray) -> np.ndarray:
+        kept, i = [corners[0]], 0
+        while i < len(corners) - 1:
+            j = len(corners) - 1
+            while j > i + 1 and not self._clear(corners[i], corners[j]):
+                j -= 1
+            kept.append(corners[j])
+            i = j
+        return np.array(kept)
+
+    def _clear(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """The segment keeps the margin, or at least what its ends have of it."""
+        count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
+        points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
+        clearance = self.proximity.clearance(points)
+        needed = min(self.margin_m, float(clearance[0]), float(clearance[-1]))
+        return bool(np.all(clearance >= needed - 1e-9))
+
+
+def route_map(world: KnownWorld) -> RouteMap:
+    """Routes through the map's voxels that keep the clearance margin (at least a body's
+    radius) widened by an estimate's allowance from the structure and the ground."""
+    control = world.scenario.control
+    margin = max(control.clearance_m, world.scenario.vehicle.radius_m)
+    return RouteMap(
+        world.map_grid(),
+        StructureProximity(world.structure),
+        margin + control.estimate_allowance_m,
+    )
