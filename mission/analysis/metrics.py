@@ -120,6 +120,8 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
         elif kind == "STATUSTEXT" and "Mission complete" in message.text:
             trace.completion = t if trace.completion is None else trace.completion
+        elif kind == "STATUSTEXT" and message.text.startswith("Inspections complete"):
+            trace.inspections_done = t
         elif kind == "STATUSTEXT" and message.text.startswith("Run stopped: "):
             trace.stopped = trace.stopped or f"{message.text[13:]} at {t:.1f} s"
         elif kind == "STATUSTEXT" and _LINK_EVENT.match(message.text):

@@ -15,6 +15,7 @@ from mission.analysis.metrics import (
     read_tlog,
     trace_metrics,
 )
+from mission.analysis.roles import role_metrics
 from mission.config.settings import Scenario
 from mission.world.model import World
 
@@ -35,4 +36,5 @@ def metrics_of(trace: RunTrace, world: World, run_dir: Path, scenario: Scenario)
         metrics["measurement_age_ms"] = measurement_ages(records)
         metrics["mpc_solve_ms"] = mpc_stats(records)
         metrics["diagnostics"] = diagnostics(trace, records, world, scenario)
+        metrics["roles"] = role_metrics(trace, records, world, scenario)
     return metrics

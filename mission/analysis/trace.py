@@ -24,6 +24,7 @@ class RunTrace:
     cycles: set[float] = field(default_factory=set)  # times of the work UAV's setpoints
     ticks: set[float] = field(default_factory=set)
     completion: float | None = None
+    inspections_done: float | None = None  # "Inspections complete": every support's too
     link_events: list[dict[str, Any]] = field(default_factory=list)
     contacts: list[dict[str, Any]] = field(default_factory=list)  # as the vehicles reported them
     events: list[dict[str, Any]] = field(default_factory=list)  # faults, sets, failures

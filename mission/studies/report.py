@@ -28,13 +28,23 @@ METRICS = (
     ("safety.least_clearance_min_m", "least clearance of a UAV [m]"),
     ("safety.touching", "contacts (from the truth)"),
 )
+# shown where a support inspected in some run (the roles of issue 33)
+ROLE_METRICS = (
+    ("roles.all_done_s", "all inspection work done [s]"),
+    ("roles.support_minutes.inspecting", "support-minutes inspecting"),
+    ("roles.role_switches", "role switches"),
+    ("roles.work_error_m.shadow.mean", "work UAV error in the shadow, mean [m]"),
+)
 PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
 
 
 def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) -> None:
     """report.md and its figures (in ``figures/``); a metric no run has (a study made before
-    the metric existed) is left out of both."""
-    metrics = tuple(m for m in METRICS if any(r.get(m[0]) is not None for r in rows))
+    the metric existed) is left out of both, and so are the roles' where no support
+    inspected."""
+    inspected = any(float(r.get("roles.support_minutes.inspecting") or 0) > 0 for r in rows)
+    shown = METRICS + (ROLE_METRICS if inspected else ())
+    metrics = tuple(m for m in shown if any(r.get(m[0]) is not None for r in rows))
     figures = write_figures(out_dir / "figures", spec, rows, metrics)
     lines = [f"# Study: {spec.name}", ""]
     if spec.description:

@@ -1,7 +1,7 @@
 """The rows of the ground station's control cycles (``records.jsonl``): the estimates, which
-supports were fused (S), beta_n, each MPC's solve time and predicted path, the current
-waypoint; and, once the truth has reached a cycle's time, the work UAV's error and the steps
-each support has spent in a zone (counted as the metrics count them)."""
+supports were fused (S), each support's role, beta_n, each MPC's solve time and predicted
+path, the current waypoint; and, once the truth has reached a cycle's time, the work UAV's
+error and the steps each support has spent in a zone (counted as the metrics count them)."""
 
 from __future__ import annotations
 
@@ -49,6 +49,10 @@ class CycleRows:
                 colour = f.colour_of(name) if name in fused else f.EXCLUDED_COLOUR
                 out.points[f.estimate_path(name)].add(t, np.array(yhat, dtype=float), colour)
                 out.scalars[f.scalar_path("fused", name)].add(t, float(name in fused))
+            for name, role in record.get("roles", {}).get("roles", {}).items():
+                badge = np.array(record["yhat"][name], dtype=float) + f.ROLE_BADGE_M
+                out.points[f.role_path(name)].add(t, badge, f.role_colour(name, role))
+                out.scalars[f.scalar_path("role", name)].add(t, f.ROLE_LEVELS[role])
             for name, beta in record.get("beta", {}).items():
                 if beta is not None:  # None: the support gave no measurement this cycle
                     out.scalars[f.scalar_path("beta", name)].add(t, float(beta))

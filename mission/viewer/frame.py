@@ -36,12 +36,17 @@ BLOCKED_COLOUR: Rgb = (255, 112, 67)
 BELOW_MARGIN_COLOUR: Rgb = (213, 0, 0)  # two UAVs closer than the separation margin
 WORST_COLOUR: Rgb = (20, 20, 20)  # the worst approach so far
 WIND_COLOUR: Rgb = (64, 160, 255)  # the free stream's arrow
+# a support off the formation (issue 33); in the formation it wears its own colour
+ROLE_COLOURS: dict[str, Rgb] = {"inspecting": (0, 230, 118), "returning": (213, 0, 249)}
+ROLE_LEVELS = {"formation": 0, "inspecting": 1, "returning": 2}  # the roles plot's values
 G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)
 G_CHANGED_M = 0.01  # a voxel is shown once G differs from its initial value by this much
 
 UAV_RADIUS_M = 0.6
 ESTIMATE_RADIUS_M = 0.3
 FIX_RADIUS_M = 0.12
+ROLE_RADIUS_M = 0.2
+ROLE_BADGE_M = np.array([0.0, 0.0, 0.7])  # the role's badge, above a support's estimate
 
 
 def colour_of(name: str) -> Rgb:
@@ -77,6 +82,16 @@ def sight_path(name: str) -> str:
 
 def mpc_path(name: str) -> str:
     return f"mpc/{name}"
+
+
+def role_path(name: str) -> str:
+    """A support's role: a badge above its estimate in the role's colour."""
+    return f"role/{name}"
+
+
+def role_colour(name: str, role: str) -> Rgb:
+    """The colour of a support's role: its own in the formation."""
+    return ROLE_COLOURS.get(role, colour_of(name))
 
 
 def current_waypoint_path(name: str) -> str:

@@ -57,6 +57,7 @@ def blueprint(scene: Scene) -> rrb.Blueprint:
         rrb.TimeSeriesView(name="fused (in S)", origin="/plots/fused", plot_legend=hidden),
         rrb.TimeSeriesView(name="MPC solve (ms)", origin="/plots/solve_ms", plot_legend=hidden),
         rrb.TimeSeriesView(name="closest approach, least clearance (m)", origin="/plots/margins"),
+        *_roles_plot(scene),
     )
     return rrb.Blueprint(
         rrb.Horizontal(
@@ -65,3 +66,11 @@ def blueprint(scene: Scene) -> rrb.Blueprint:
         rrb.TimePanel(timeline=f.TIMELINE, play_state="following", state="collapsed"),
         collapse_panels=True,
     )
+
+
+def _roles_plot(scene: Scene) -> list:
+    """Where supports have inspections of their own: their roles over time."""
+    if not scene.inspections:
+        return []
+    name = "role (0 formation, 1 inspecting, 2 returning)"
+    return [rrb.TimeSeriesView(name=name, origin="/plots/role")]

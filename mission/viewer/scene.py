@@ -4,7 +4,7 @@ ground station never sees them), the workspace and each vehicle's planned waypoi
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -27,6 +27,7 @@ class Scene:
     voxel_origin: np.ndarray
     voxel_m: float
     wind: np.ndarray  # the free stream (ENU, m/s); zeros in still air
+    inspections: dict[str, np.ndarray] = field(default_factory=dict)  # a support's own, (n, 3)
 
 
 def build_scene(scenario: Scenario, world: World) -> Scene:
@@ -50,4 +51,5 @@ def build_scene(scenario: Scenario, world: World) -> Scene:
         voxel_origin=np.array(grid.origin_m, dtype=float),
         voxel_m=float(grid.voxel_m),
         wind=WindField(scenario.world.wind, []).free_stream,
+        inspections={i.vehicle: np.array(i.waypoints_m) for i in scenario.task.inspections},
     )

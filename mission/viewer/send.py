@@ -9,13 +9,19 @@ import rerun as rr
 from mission.viewer import frame as f
 from mission.viewer.scene import Scene
 
-_POINT_RADII = {"uav": f.UAV_RADIUS_M, "estimate": f.ESTIMATE_RADIUS_M, "gnss": f.FIX_RADIUS_M}
+_POINT_RADII = {
+    "uav": f.UAV_RADIUS_M,
+    "estimate": f.ESTIMATE_RADIUS_M,
+    "gnss": f.FIX_RADIUS_M,
+    "role": f.ROLE_RADIUS_M,
+}
 _SERIES = {  # scalar kind: its name in the legend
     "work_error": "work UAV error (m)",
     "beta": "beta",
     "solve_ms": "MPC solve (ms)",
     "zone_steps": "steps in a zone",
     "fused": "in S",
+    "role": "role",
 }
 
 
@@ -69,6 +75,11 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
                 rr.LineStrips3D([points], colors=colour, radii=0.02),
                 static=True,
             )
+    for name, points in scene.inspections.items():  # a support's own, in the inspecting colour
+        colour = f.ROLE_COLOURS["inspecting"]
+        rec.log(
+            f"plan/{name}/inspections", rr.Points3D(points, colors=colour, radii=0.15), static=True
+        )
     for name in scene.waypoints:
         colour = f.colour_of(name)
         for kind, label in _SERIES.items():

@@ -39,3 +39,26 @@ def test_in_the_open_supports_inspect_and_are_back_before_the_shadow(tmp_path):
     for record, role in zip(records, roles):
         if record["own_fix"]["reason"] in OFF_SKY or record["blind"]:
             assert set(role.values()) == {"formation"}, (record["t"], role)  # recalled in time
+
+    # the summary's roles and the 3-D view's
+    block = summary["roles"]
+    assert block["policy"] == "dynamic" and block["support_minutes"]["inspecting"] > 0
+    assert block["role_switches"] >= 2 and block["all_done_s"] is None  # stopped at 120 s
+    saved = tmp_path / "run.rrd"
+    assert mission("view", str(tmp_path / "run"), "--save", str(saved)).returncode == 0
+    from mission.viewer.frame import ROLE_LEVELS, role_colour
+    from tests.viewer.rrd import read_rrd
+
+    rows = read_rrd(saved)
+    for name in ("support-1", "support-2", "support-3"):
+        levels = [v[0] for v in rows[f"/plots/role/{name}"]["Scalars:scalars"]]
+        assert levels == [ROLE_LEVELS[r[name]] for r in roles]
+        colours = rows[f"/role/{name}"]["Points3D:colors"]
+        assert len(colours) == len(roles)
+        assert [tuple(_rgb(c[0])) for c in colours] == [role_colour(name, r[name]) for r in roles]
+    assert "/plan/support-2/inspections" in rows
+
+
+def _rgb(packed: int) -> tuple[int, int, int]:
+    """Rerun's 0xRRGGBBAA colour as (r, g, b)."""
+    return ((packed >> 24) & 255, (packed >> 16) & 255, (packed >> 8) & 255)
