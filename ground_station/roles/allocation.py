@@ -44,6 +44,7 @@ from ground_station.support_mpc.mpc import SupportPlan
 
 HANDOVER_M = 2.0  # a returning support this close to its formation waypoint rejoins
 CORNER_TOL_M = 0.3  # a route's corner (not an inspection waypoint) is passed this close
+REROUTE_AFTER = 10  # cycles held giving way before a route round the others is sought
 
 
 def inspections_left(allocation: Allocation, context: RunContext) -> bool:
@@ -104,6 +105,8 @@ def _progress(state: StationState, context: RunContext, allocation: Allocation) 
         if support.role == FORMATION:
             continue
         yhat = state.yhat[name]
+        if support.held >= REROUTE_AFTER and support.route is not None:  # a way round them
+            support.route, support.held = _routed(state, context, name, support.route[-1]), 0
         while support.route is not None and len(support.route) > 1:
             if np.linalg.norm(support.route[0] - yhat) >= CORNER_TOL_M:
                 break
@@ -120,7 +123,8 @@ def _progress(state: StationState, context: RunContext, allocation: Allocation) 
                     _set(allocation, name, RETURNING, _route_home(state, context, name))
         elif support.role == RETURNING:
             home = _formation_waypoint(state, context, name)
-            if np.linalg.norm(home - yhat) < HANDOVER_M or len(support.route) <= 1:
+            at_end = np.linalg.norm(support.route[-1] - yhat) < CORNER_TOL_M
+            if np.linalg.norm(home - yhat) < HANDOVER_M or at_end:
                 _set(allocation, name, FORMATION, None)
                 state.warm.pop(name, None)  # its MPC starts afresh from where it is
 
@@ -139,18 +143,29 @@ def _formation_waypoint(state: StationState, context: RunContext, name: str) -> 
 
 def _route_to_inspection(state, context, allocation, name) -> np.ndarray:
     goal = context.inspections[name][allocation.supports[name].next_inspection]
-    return _routed(context, state.yhat[name], goal)
+    return _routed(state, context, name, goal)
 
 
 def _route_home(state: StationState, context: RunContext, name: str) -> np.ndarray:
-    return _routed(context, state.yhat[name], _formation_waypoint(state, context, name))
+    return _routed(state, context, name, _formation_waypoint(state, context, name))
 
 
-def _routed(context: RunContext, start: np.ndarray, goal: np.ndarray) -> np.ndarray:
-    """The route's corners after ``start`` (the straight way where no free way is found)."""
+def _routed(state: StationState, context: RunContext, name: str, goal: np.ndarray) -> np.ndarray:
+    """The corners after the support's estimate of a route to ``goal`` that keeps off the
+    other UAVs' estimates by the separation (the straight way where none is found)."""
     assert context.routes is not None
-    route = context.routes.route(start, goal)
+    others = np.array([state.xhat, *(p for n, p in state.yhat.items() if n != name)])
+    route = context.routes.route(state.yhat[name], goal, others, _crowding_m(context))
     return np.array([goal]) if route is None else route[1:]
+
+
+def _crowding_m(context: RunContext) -> float:
+    """How close to another UAV's estimate a routed support does not go: the separation
+    widened by two estimates' allowance (0: no separation margin)."""
+    control = context.scenario.control
+    if control.min_separation_m <= 0:
+        return 0.0
+    return control.min_separation_m + 2 * control.estimate_allowance_m
 
 
 def routed_plans(state: StationState, context: RunContext, allocation: Allocation):
@@ -166,6 +181,7 @@ def routed_plans(state: StationState, context: RunContext, allocation: Allocatio
         yhat = state.yhat[name]
         path = _along(yhat, support.route, reach, horizon)
         away = _give_way(state, context, name, path[0])
+        support.held = 0 if away is None else support.held + 1
         if away is not None:
             path = np.repeat(away[None], horizon, axis=0)
         blocked = np.zeros(horizon, dtype=bool)
@@ -186,9 +202,9 @@ def _give_way(state, context, name, command) -> np.ndarray | None:
     """A step straight away from the nearest UAV whose separation ``command`` would break
     (and come closer), or None."""
     control = context.scenario.control
-    if control.min_separation_m <= 0:
+    needed = _crowding_m(context)
+    if needed <= 0:
         return None
-    needed = control.min_separation_m + 2 * control.estimate_allowance_m
     yhat = state.yhat[name]
     others = [state.xhat, *(p for n, p in state.yhat.items() if n != name)]
     crowded = [

@@ -13,11 +13,13 @@ FORMATION, INSPECTING, RETURNING = "formation", "inspecting", "returning"
 
 @dataclass
 class SupportRole:
-    """One support's role, its next inspection waypoint and the corners left on its route."""
+    """One support's role, its next inspection waypoint, the corners left on its route and how
+    long it has been giving way."""
 
     role: str = FORMATION
     next_inspection: int = 0
     route: np.ndarray | None = None
+    held: int = 0  # cycles in a row it gave way
 
 
 @dataclass

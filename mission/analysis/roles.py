@@ -42,7 +42,7 @@ def role_metrics(
             if f"support-{name - 1}" not in roles:
                 seconds["formation"] += scenario.control.t_cont_s
     reached = records[-1].get("roles", {}).get("next_inspection", {}) if records else {}
-    arrivals = sum(1 for r in records if r.get("arrived") is not None)
+    arrivals = len({r["arrived"] for r in records if r.get("arrived") is not None})
     to_reach = {"work": (arrivals, len(scenario.task.work_waypoints_m) - 1)}  # from the first
     to_reach |= {n: (int(reached.get(n, 0)), total) for n, total in sorted(inspections.items())}
     waypoints = {n: {"reached": a, "of": b} for n, (a, b) in to_reach.items()}

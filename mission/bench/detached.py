@@ -11,8 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.cycle import CycleOutput, run_cycle
+from ground_station.cycle import CycleOutput, complete_cycle, control_cycle
 from ground_station.localize import SupportReport
+from ground_station.roles.allocation import inspections_left
 from ground_station.run_context import build_run_context
 from mission.world.model import World
 from vehicle_sim.kinematics import Kinematics
@@ -39,6 +40,7 @@ def run_detached(
     control = scenario.control
     context, state = build_run_context(world.known(), waypoints, adaptive, seed)
     rng = np.random.default_rng([seed, 99])
+    own_rng = np.random.default_rng([seed, 98])  # the work UAV's own fixes (dynamic roles)
     vehicles = {name: Kinematics.at(points[0]) for name, points in waypoints.items()}
     speed = {
         name: control.s_max_work_m_s if name == "work" else control.s_max_support_m_s
@@ -54,10 +56,14 @@ def run_detached(
             observation = world.camera.observe(y, work_truth, rng)
             position = fix.position_m if fix.has_fix else None
             reports.append(SupportReport(name, position, observation.relative_m))
-        output = run_cycle(state, reports, context)
+        work_fix = None
+        if scenario.roles.policy == "dynamic":
+            fix = world.gnss.sample_fix(work_truth, own_rng, world.zone_offset(work_truth[None])[0])
+            work_fix = fix.position_m if fix.has_fix else None
+        output = complete_cycle(state, control_cycle(state, reports, context, work_fix), context)
         outputs.append(output)
         truth.append(work_truth.copy())
-        if not output.fusion.blind:  # blind, the work UAV holds on its own dead reckoning
+        if not output.blind:  # blind, the work UAV holds on its own dead reckoning
             vehicles["work"].set_estimate(state.xhat)
         vehicles["work"].target = output.work_target
         for name, target in output.support_targets.items():
@@ -65,6 +71,6 @@ def run_detached(
             vehicles[name].target = target
         for name, vehicle in vehicles.items():
             vehicle.step(control.t_cont_s, speed[name], rng, scenario.vehicle.tracking_noise_m)
-        if state.completed:
+        if state.completed and not inspections_left(state.allocation, context):
             break
     return DetachedRun(outputs, np.array(truth), state.completed)

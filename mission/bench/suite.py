@@ -18,6 +18,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.bench.margins import bench_margins
 from mission.bench.result import BenchResult
+from mission.bench.roles import bench_roles
 from mission.bench.study import bench_studies
 from mission.bench.view import bench_view
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
@@ -352,6 +353,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "vehicle": bench_vehicle,
     "gcs": bench_ground_station,
     "margins": bench_margins,
+    "roles": bench_roles,
     "run": bench_runs,
     "study": bench_studies,
     "view": bench_view,

@@ -6,7 +6,8 @@ structure first. The map G's voxel grid is the graph: a voxel is free where its 
 least ``margin_m`` from the structure and the ground, and free voxels that touch (26
 neighbours) are joined by their centres' distance. Dijkstra's algorithm (scipy's csgraph)
 gives the shortest way; the voxel path is then pulled straight: each corner is skipped where
-the segment past it keeps the margin (sampled every quarter voxel).
+the segment past it keeps the margin (sampled every quarter voxel). A route can also keep off
+balls around other UAVs (their voxels taken out of the graph for that route).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-from scipy.sparse import coo_matrix
+from scipy.sparse import coo_matrix, diags
 from scipy.sparse.csgraph import dijkstra
 
 from mission.world.grid import VoxelGrid
@@ -76,39 +77,72 @@ class RouteMap:
         lead_out = np.linalg.norm(self.centres[end_cells] - targets, axis=1)
         return through + lead_in[:, None] + lead_out[None, :]
 
-    def route(self, start: np.ndarray, goal: np.ndarray) -> np.ndarray | None:
-        """Corners from ``start`` to ``goal`` (both included), pulled straight; None where no
-        free way joins them."""
+    def route(
+        self, start: np.ndarray, goal: np.ndarray, avoid: np.ndarray | None = None, radius_m=0.0
+    ) -> np.ndarray | None:
+        """Corners from ``start`` to ``goal`` (both included), pulled straight, and kept
+        ``radius_m`` from each point of ``avoid`` (other UAVs) where the ends are; None where
+        no free way joins them."""
         start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-        if self._clear(start, goal):
+        avoid = np.zeros((0, 3)) if avoid is None else np.atleast_2d(avoid)
+        keep_off = Obstacles(avoid, radius_m)
+        if self._clear(start, goal, keep_off):
             return np.vstack([start, goal])
         first, last = self.cell_of(start), self.cell_of(goal)
-        _, previous = dijkstra(self.graph, indices=first, return_predecessors=True)
+        graph = self.graph if not len(avoid) else self._without(keep_off, (first, last))
+        _, previous = dijkstra(graph, indices=first, return_predecessors=True)
         if first != last and previous[last] < 0:
             return None
         cells = [last]
         while cells[-1] != first:
             cells.append(int(previous[cells[-1]]))
         corners = np.vstack([start, self.centres[cells[::-1]], goal])
-        return self._pulled(corners)
+        return self._pulled(corners, keep_off)
 
-    def _pulled(self, corners: np.ndarray) -> np.ndarray:
+    def _without(self, keep_off: Obstacles, ends: tuple[int, int]):
+        """The graph without the voxels ``keep_off`` covers (but the route's ends)."""
+        keep = ~keep_off.covers(self.centres)
+        keep[list(ends)] = True
+        mask = diags(keep.astype(float))
+        graph = (mask @ self.graph @ mask).tocsr()
+        graph.eliminate_zeros()
+        return graph
+
+    def _pulled(self, corners: np.ndarray, keep_off: Obstacles) -> np.ndarray:
         kept, i = [corners[0]], 0
         while i < len(corners) - 1:
             j = len(corners) - 1
-            while j > i + 1 and not self._clear(corners[i], corners[j]):
+            while j > i + 1 and not self._clear(corners[i], corners[j], keep_off):
                 j -= 1
             kept.append(corners[j])
             i = j
         return np.array(kept)
 
-    def _clear(self, a: np.ndarray, b: np.ndarray) -> bool:
-        """The segment keeps the margin, or at least what its ends have of it."""
+    def _clear(self, a: np.ndarray, b: np.ndarray, keep_off: Obstacles) -> bool:
+        """The segment keeps the margin, or at least what its ends have of it, and stays off
+        the obstacles (where its ends are)."""
         count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
         points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
         clearance = self.proximity.clearance(points)
         needed = min(self.margin_m, float(clearance[0]), float(clearance[-1]))
-        return bool(np.all(clearance >= needed - 1e-9))
+        if not np.all(clearance >= needed - 1e-9):
+            return False
+        inside = keep_off.covers(points)
+        return not np.any(inside & ~inside[0] & ~inside[-1])
+
+
+class Obstacles:
+    """Balls of ``radius_m`` around ``centres`` (other UAVs) a route keeps off."""
+
+    def __init__(self, centres: np.ndarray, radius_m: float) -> None:
+        self.centres, self.radius_m = centres, radius_m
+
+    def covers(self, points: np.ndarray) -> np.ndarray:
+        """Which points lie inside a ball."""
+        if not len(self.centres):
+            return np.zeros(len(points), dtype=bool)
+        gaps = np.linalg.norm(points[:, None] - self.centres[None], axis=2)
+        return np.any(gaps < self.radius_m, axis=1)
 
 
 def route_map(world: KnownWorld) -> RouteMap:
