@@ -118,14 +118,8 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             pending_estimate = None
         elif kind == "SYSTEM_TIME" and message.time_boot_ms > 0:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
-        elif kind == "STATUSTEXT" and "Mission complete" in message.text:
-            trace.completion = t if trace.completion is None else trace.completion
-        elif kind == "STATUSTEXT" and message.text.startswith("Inspections complete"):
-            trace.inspections_done = t
-        elif kind == "STATUSTEXT" and message.text.startswith("Run stopped: "):
-            trace.stopped = trace.stopped or f"{message.text[13:]} at {t:.1f} s"
-        elif kind == "STATUSTEXT" and _LINK_EVENT.match(message.text):
-            trace.link_events.append({"t": t, "event": message.text})
+        elif kind == "STATUSTEXT":
+            _station_said(trace, message.text, t)
     offsets = {} if trace.ticks else clock_offsets(replies)
     epoch_usec = round(epoch * 1e6)
     for kind, into in ((TRUTH, trace.truth), (BELIEF, trace.beliefs)):
@@ -133,6 +127,19 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             if trace.ticks or system in offsets:
                 into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
     return trace
+
+
+def _station_said(trace: RunTrace, text: str, t: float) -> None:
+    """What the ground station's STATUSTEXT at ``t`` tells: completion, the inspections'
+    end, a stop, a link event."""
+    if "Mission complete" in text:
+        trace.completion = t if trace.completion is None else trace.completion
+    elif text.startswith("Inspections complete"):
+        trace.inspections_done = t
+    elif text.startswith("Run stopped: "):
+        trace.stopped = trace.stopped or f"{text[13:]} at {t:.1f} s"
+    elif _LINK_EVENT.match(text):
+        trace.link_events.append({"t": t, "event": text})
 
 
 TRUTH, BELIEF = "truth", "belief"

@@ -66,6 +66,20 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
         static=True,
     )
     _send_wind(rec, scene)
+    _send_plans(rec, scene)
+    for name in scene.waypoints:
+        colour = f.colour_of(name)
+        for kind, label in _SERIES.items():
+            if name != "work" and kind != "work_error":
+                series = rr.SeriesLines(colors=colour, names=f"{name} {label}")
+                rec.log(f.scalar_path(kind, name), series, static=True)
+    series = rr.SeriesLines(colors=f.WORK_COLOUR, names=_SERIES["work_error"])
+    rec.log(f.scalar_path("work_error"), series, static=True)
+
+
+def _send_plans(rec: rr.RecordingStream, scene: Scene) -> None:
+    """Each vehicle's planned waypoints and route, and the supports' own inspection waypoints
+    (in the inspecting colour)."""
     for name, points in scene.waypoints.items():
         if len(points):
             colour = f.colour_of(name)
@@ -75,19 +89,11 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
                 rr.LineStrips3D([points], colors=colour, radii=0.02),
                 static=True,
             )
-    for name, points in scene.inspections.items():  # a support's own, in the inspecting colour
+    for name, points in scene.inspections.items():
         colour = f.ROLE_COLOURS["inspecting"]
         rec.log(
             f"plan/{name}/inspections", rr.Points3D(points, colors=colour, radii=0.15), static=True
         )
-    for name in scene.waypoints:
-        colour = f.colour_of(name)
-        for kind, label in _SERIES.items():
-            if name != "work" and kind != "work_error":
-                series = rr.SeriesLines(colors=colour, names=f"{name} {label}")
-                rec.log(f.scalar_path(kind, name), series, static=True)
-    series = rr.SeriesLines(colors=f.WORK_COLOUR, names=_SERIES["work_error"])
-    rec.log(f.scalar_path("work_error"), series, static=True)
 
 
 def _send_wind(rec: rr.RecordingStream, scene: Scene) -> None:

@@ -3,6 +3,8 @@ deck to above it, kept off the structure by the margin and off other UAVs where 
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -24,7 +26,7 @@ def routes() -> RouteMap:
 def _sampled(route: np.ndarray, spacing: float = 0.05) -> np.ndarray:
     return np.vstack(
         [a + (b - a) * np.linspace(0, 1, int(np.linalg.norm(b - a) / spacing) + 2)[:, None]
-         for a, b in zip(route[:-1], route[1:])]
+         for a, b in itertools.pairwise(route)]
     )  # fmt: skip
 
 
