@@ -3,7 +3,7 @@
 Each support is in one of three roles:
 
 - ``formation``: planned by its MPC around the work UAV (the paper's role);
-- ``inspecting``: flying a route (:mod:`ground_station.roles.routes`) to its next inspection
+- ``inspecting``: flying a route (:mod:`mission.world.routes`) to its next inspection
   waypoint (``task.inspections``), then the next, until it has reached them all;
 - ``returning``: flying a route back to its formation waypoint; within ``HANDOVER_M`` of it
   (or at the route's end) its MPC takes it again.
@@ -18,10 +18,12 @@ two nothing changes: a path along a shadow's edge recalls once and releases agai
 go inspecting only once the work UAV's task is complete. A support that has reached all its
 inspection waypoints returns to the formation (or, the task complete, holds there).
 
-A routed support steps toward its route's next corner by at most its reach; where that step
-would bring it within the separation (widened by two estimates' allowance) of another UAV's
-estimate, and closer, it steps straight away from that UAV instead (it gives way: the work UAV
-and the formation's MPCs plan around it from its estimate and its predicted route).
+A route keeps off the other UAVs' estimates by the separation widened by two estimates'
+allowance. A routed support steps along it by at most its reach; where that step would bring
+it that close to another UAV's estimate, and closer, it steps straight away from that UAV
+instead, or holds where away is toward the structure (it gives way: the work UAV and the
+formation's MPCs plan around it from its estimate and its predicted route); after
+``REROUTE_AFTER`` such cycles it is routed afresh round the others where they are then.
 """
 
 from __future__ import annotations
