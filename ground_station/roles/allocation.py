@@ -6,7 +6,11 @@ Each support is in one of three roles:
 - ``inspecting``: flying a route (:mod:`mission.world.routes`) to its next inspection
   waypoint (``task.inspections``), then the next, until it has reached them all;
 - ``returning``: flying a route back to its formation waypoint; within ``HANDOVER_M`` of it
-  (or at the route's end) its MPC takes it again.
+  (or at the route's end) its MPC takes it again. A formation support whose waypoint lies
+  behind the structure (the straight way to it comes within the clearance margin of it, and
+  it is more than ``TRANSIT_M`` away) is sent the same way: the MPC plans locally, and a pier
+  or the deck between it and its waypoint can hold it (in the piers scenario one such
+  support, GNSS-denied under the deck, drifted into the east pier).
 
 With ``roles.policy: dynamic``, each cycle the work UAV's path ahead is looked at
 (:mod:`ground_station.roles.lookahead`): where its own fix is expected trustworthy for
@@ -47,6 +51,7 @@ from ground_station.support_mpc.mpc import SupportPlan
 HANDOVER_M = 2.0  # a returning support this close to its formation waypoint rejoins
 CORNER_TOL_M = 0.3  # a route's corner (not an inspection waypoint) is passed this close
 REROUTE_AFTER = 10  # cycles held giving way before a route round the others is sought
+TRANSIT_M = 4.0  # a formation support farther from its waypoint, behind the structure, is routed
 
 
 def inspections_left(allocation: Allocation, context: RunContext) -> bool:
@@ -65,6 +70,7 @@ def allocate(state: StationState, context: RunContext, allocation: Allocation) -
     for name in context.inspections:
         allocation.supports.setdefault(name, SupportRole())
     _progress(state, context, allocation)
+    _send_round_the_structure(state, context, allocation)
     roles = context.scenario.roles
     if roles.policy == "dynamic" and not state.completed:
         allocation.clear_s = clear_ahead_s(
@@ -84,6 +90,25 @@ def allocate(state: StationState, context: RunContext, allocation: Allocation) -
                 _set(allocation, name, RETURNING, _route_home(state, context, name))
     elif allocation.clear_s >= roles.release_clear_s:
         _release(state, context, allocation)
+
+
+def _send_round_the_structure(
+    state: StationState, context: RunContext, allocation: Allocation
+) -> None:
+    """A formation support more than ``TRANSIT_M`` from its formation waypoint with the
+    structure in the straight way (within the clearance margin of it) is routed there
+    (``returning``): its MPC plans locally and can be held behind a pier or the deck."""
+    assert context.routes is not None
+    margin = max(context.scenario.control.clearance_m, context.scenario.vehicle.radius_m)
+    for name, support in allocation.supports.items():
+        if support.role != FORMATION:
+            continue
+        home = _formation_waypoint(state, context, name)
+        yhat = state.yhat[name]
+        if np.linalg.norm(home - yhat) <= TRANSIT_M:
+            continue
+        if context.routes.structure_between(yhat, home, margin):
+            _set(allocation, name, RETURNING, _routed(state, context, name, home))
 
 
 def _release(state: StationState, context: RunContext, allocation: Allocation) -> None:

@@ -99,6 +99,13 @@ class RouteMap:
         corners = np.vstack([start, self.centres[cells[::-1]], goal])
         return self._pulled(corners, keep_off)
 
+    def structure_between(self, a: np.ndarray, b: np.ndarray, margin_m: float) -> bool:
+        """Whether the straight way from ``a`` to ``b`` comes within ``margin_m`` of the
+        structure (the ground not counted; sampled every quarter voxel)."""
+        count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
+        points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
+        return bool(np.any(self.proximity.distance(points) < margin_m))
+
     def _without(self, keep_off: Obstacles, ends: tuple[int, int]):
         """The graph without the voxels ``keep_off`` covers (but the route's ends)."""
         keep = ~keep_off.covers(self.centres)

@@ -41,9 +41,9 @@ OVERLAP = (
 INSPECTIONS = "task:\n  inspections:\n    - {vehicle: %s, waypoints_m: [%s]}\n"
 
 HYSTERESIS = "roles: {policy: dynamic, release_clear_s: 30, recall_clear_s: 40}\n"
-LATE_RECALL = (
-    "roles: {policy: dynamic, release_clear_s: 3, recall_clear_s: 2}\n"
-    + INSPECTIONS % ("support-1", "[0.0, -16.0, 3.0]")
+LATE_RECALL = "roles: {policy: dynamic, release_clear_s: 3, recall_clear_s: 2}\n" + INSPECTIONS % (
+    "support-1",
+    "[0.0, -16.0, 3.0]",
 )
 
 NEW_PATH = "task: {work_waypoints_m: [[-12.0, -3.0, 7.0], [-12.0, 3.0, 7.0]]}\n"

@@ -40,7 +40,11 @@ def context():
     grid = world.map_grid()
     centres = grid.centers()
     sigma = np.where(centres[..., 0] >= 0.0, SHADOW_SIGMA, OPEN_SIGMA)
-    supports = {f"support-{n}": read_vehicle_waypoints(scenario, f"support-{n}") for n in (1, 2, 3)}
+    # each support's formation waypoint where it starts, in the open, for every waypoint
+    supports = {
+        f"support-{n}": np.repeat(read_vehicle_waypoints(scenario, f"support-{n}")[:1], 30, axis=0)
+        for n in (1, 2, 3)
+    }
     return SimpleNamespace(
         scenario=scenario,
         work_waypoints=WORK_PATH,
@@ -123,3 +127,32 @@ def test_a_routed_support_gives_way_to_the_work_uav(context):
     plan = routed_plans(state, context, state.allocation)["support-1"]
     reach = context.scenario.control.s_max_support_m_s * context.scenario.control.t_cont_s
     np.testing.assert_allclose(plan.command, [-18.0, -13.0 - reach, 5.0])  # straight away
+
+
+def test_a_formation_support_behind_a_pier_is_routed_round_it(context):
+    """Its waypoint on the far side of the east pier (x 15..17, y -3..3, z 0..8): routed
+    ('returning') round it; one a clear way off, or within 4 m, is left to its MPC."""
+    behind = SimpleNamespace(**vars(context))
+    roles = context.scenario.roles
+    fixed = dataclasses.replace(roles, policy="fixed")  # none released: the task goes on
+    behind.scenario = dataclasses.replace(context.scenario, roles=fixed)
+    behind.support_waypoints = {
+        "support-1": np.array([[20.0, 0.0, 4.0]] * 2),  # east of the pier; it is west
+        "support-2": np.array([[-10.0, -15.0, 4.0]] * 2),  # far, in the open
+        "support-3": np.array([[12.0, 0.0, 5.0]] * 2),  # 3 m away
+    }
+    state = StationState(
+        xhat=np.array([-20.0, -12.0, 5.0]),
+        yhat={
+            "support-1": np.array([12.0, -1.0, 4.0]),
+            "support-2": np.array([0.0, -15.0, 4.0]),
+            "support-3": np.array([12.0, 3.0, 5.0]),  # 3 m from its waypoint
+        },
+        k=1,
+    )
+    allocate(state, behind, state.allocation)
+    roles = {n: s.role for n, s in state.allocation.supports.items()}
+    assert roles == {"support-1": "returning", "support-2": "formation", "support-3": "formation"}
+    route = np.vstack([state.yhat["support-1"], state.allocation.supports["support-1"].route])
+    assert context.routes.proximity.distance(route).min() > 1.0  # its corners clear the pier
+    assert not context.routes.structure_between(route[0], route[1], 0.5)  # and so its legs
