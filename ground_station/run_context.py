@@ -66,7 +66,7 @@ def build_run_context(
         np.random.default_rng(seed),
         planner,
         inspections,
-        route_map(world) if inspections else None,
+        route_map(world, sigma0) if inspections else None,
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),

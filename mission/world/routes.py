@@ -4,8 +4,10 @@ The formation's MPC plans a support locally, around the work UAV; a support flyi
 inspection waypoint (on the far side of a pier, on top of the deck) needs a way around the
 structure first. The map G's voxel grid is the graph: a voxel is free where its centre is at
 least ``margin_m`` from the structure and the ground, and free voxels that touch (26
-neighbours) are joined by their centres' distance. Dijkstra's algorithm (scipy's csgraph)
-gives the shortest way; the voxel path is then pulled straight: each corner is skipped where
+neighbours) are joined by their centres' distance, ten times that where either voxel has no
+GNSS fix (a support routed through the deck's shadow flies on a drifting estimate: a route
+keeps to open sky where it can). Dijkstra's algorithm (scipy's csgraph) gives the least
+costly way; the voxel path is then pulled straight: each corner is skipped where
 the segment past it keeps the margin (sampled every quarter voxel). A route can also keep off
 balls around other UAVs (their voxels taken out of the graph for that route).
 """
@@ -22,17 +24,26 @@ from mission.world.grid import VoxelGrid
 from mission.world.model import KnownWorld
 from mission.world.proximity import StructureProximity
 
+SHADOW_COST = 10.0  # a metre without a GNSS fix costs as much as ten in the open
 NEIGHBOURS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)])
 
 
 class RouteMap:
     """Shortest routes between points through the free voxels of ``grid``."""
 
-    def __init__(self, grid: VoxelGrid, proximity: StructureProximity, margin_m: float) -> None:
+    def __init__(
+        self,
+        grid: VoxelGrid,
+        proximity: StructureProximity,
+        margin_m: float,
+        shadow: np.ndarray | None = None,
+    ) -> None:
         self.grid, self.proximity, self.margin_m = grid, proximity, margin_m
         centres = grid.centers().reshape(-1, 3)
         self.free = proximity.clearance(centres) >= margin_m
         self.centres = centres
+        # voxels without a GNSS fix: an edge touching one costs SHADOW_COST times its length
+        self.shadow = np.zeros(len(centres), bool) if shadow is None else shadow.reshape(-1)
         self.graph = self._graph()
 
     def _graph(self):
@@ -50,7 +61,9 @@ class RouteMap:
             keep = self.free[here] & self.free[shifted]
             rows.append(here[keep])
             cols.append(shifted[keep])
-            weights.append(np.full(int(keep.sum()), self.grid.voxel_m * np.linalg.norm(offset)))
+            dark = self.shadow[here[keep]] | self.shadow[shifted[keep]]
+            length = self.grid.voxel_m * np.linalg.norm(offset)
+            weights.append(np.where(dark, SHADOW_COST * length, length))
         n = self.grid.n_voxels
         return coo_matrix(
             (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
@@ -67,15 +80,21 @@ class RouteMap:
         return int(free[np.argmin(gaps)])
 
     def lengths(self, sources: np.ndarray, targets: np.ndarray) -> np.ndarray:
-        """(sources, targets): the length of the shortest voxel way between each pair, from
-        each point to its free voxel's centre and on (infinity where none joins them)."""
+        """(sources, targets): the length (m) of the route between each pair, from each
+        point to its free voxel's centre, along the least costly voxel way, and on (infinity
+        where none joins them)."""
         sources, targets = np.atleast_2d(sources), np.atleast_2d(targets)
         start_cells = [self.cell_of(p) for p in sources]
         end_cells = [self.cell_of(p) for p in targets]
-        through = dijkstra(self.graph, indices=start_cells)[:, end_cells]
-        lead_in = np.linalg.norm(self.centres[start_cells] - sources, axis=1)
-        lead_out = np.linalg.norm(self.centres[end_cells] - targets, axis=1)
-        return through + lead_in[:, None] + lead_out[None, :]
+        _, previous = dijkstra(self.graph, indices=start_cells, return_predecessors=True)
+        result = np.full((len(sources), len(targets)), np.inf)
+        for i, first in enumerate(start_cells):
+            for j, last in enumerate(end_cells):
+                cells = _walk_back(previous[i], first, last)
+                if cells is not None:
+                    corners = np.vstack([sources[i], self.centres[cells], targets[j]])
+                    result[i, j] = float(np.sum(np.linalg.norm(np.diff(corners, axis=0), axis=1)))
+        return result
 
     def route(
         self, start: np.ndarray, goal: np.ndarray, avoid: np.ndarray | None = None, radius_m=0.0
@@ -91,12 +110,10 @@ class RouteMap:
         first, last = self.cell_of(start), self.cell_of(goal)
         graph = self.graph if not len(avoid) else self._without(keep_off, (first, last))
         _, previous = dijkstra(graph, indices=first, return_predecessors=True)
-        if first != last and previous[last] < 0:
+        cells = _walk_back(previous, first, last)
+        if cells is None:
             return None
-        cells = [last]
-        while cells[-1] != first:
-            cells.append(int(previous[cells[-1]]))
-        corners = np.vstack([start, self.centres[cells[::-1]], goal])
+        corners = np.vstack([start, self.centres[cells], goal])
         return self._pulled(corners, keep_off)
 
     def structure_between(self, a: np.ndarray, b: np.ndarray, margin_m: float) -> bool:
@@ -126,8 +143,8 @@ class RouteMap:
         return np.array(kept)
 
     def _clear(self, a: np.ndarray, b: np.ndarray, keep_off: Obstacles) -> bool:
-        """The segment keeps the margin, or at least what its ends have of it, and stays off
-        the obstacles (where its ends are)."""
+        """The segment keeps the margin, or at least what its ends have of it, stays off the
+        obstacles (but where its ends are) and, from open sky to open sky, out of the shadow."""
         count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
         points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
         clearance = self.proximity.clearance(points)
@@ -135,7 +152,25 @@ class RouteMap:
         if not np.all(clearance >= needed - 1e-9):
             return False
         inside = keep_off.covers(points)
-        return not np.any(inside & ~inside[0] & ~inside[-1])
+        if np.any(inside & ~inside[0] & ~inside[-1]):
+            return False
+        dark = self.in_shadow(points)  # open sky to open sky stays in the open
+        return bool(dark[0] or dark[-1] or not np.any(dark))
+
+    def in_shadow(self, points: np.ndarray) -> np.ndarray:
+        """Which points lie in a voxel without a GNSS fix."""
+        index = self.grid.index_of(points)
+        return self.shadow[np.ravel_multi_index(tuple(index.T), self.grid.shape)]
+
+
+def _walk_back(previous: np.ndarray, first: int, last: int) -> list[int] | None:
+    """The voxels from ``first`` to ``last`` by Dijkstra's predecessors (None: not joined)."""
+    if first != last and previous[last] < 0:
+        return None
+    cells = [last]
+    while cells[-1] != first:
+        cells.append(int(previous[cells[-1]]))
+    return cells[::-1]
 
 
 class Obstacles:
@@ -152,13 +187,18 @@ class Obstacles:
         return np.any(gaps < self.radius_m, axis=1)
 
 
-def route_map(world: KnownWorld) -> RouteMap:
+def route_map(world: KnownWorld, sigma0: np.ndarray | None = None) -> RouteMap:
     """Routes through the map's voxels that keep the clearance margin (at least a body's
-    radius) widened by an estimate's allowance from the structure and the ground."""
+    radius) widened by an estimate's allowance from the structure and the ground, and keep to
+    open sky where they can (``sigma0``: the world's sigma_0 map, if already computed; its
+    no-fix voxels are the shadow)."""
     control = world.scenario.control
     margin = max(control.clearance_m, world.scenario.vehicle.radius_m)
+    if sigma0 is None:
+        sigma0 = world.sigma0_map().sigma_m
     return RouteMap(
         world.map_grid(),
         StructureProximity(world.structure),
         margin + control.estimate_allowance_m,
+        np.asarray(sigma0) >= world.scenario.map.no_fix_sigma_m,
     )

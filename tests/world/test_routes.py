@@ -59,3 +59,18 @@ def test_a_route_keeps_off_another_uav(routes):
     assert len(route) > 2
     assert Obstacles(other, 3.5 - 0.05).covers(_sampled(route)).sum() == 0
     assert routes.route(start, goal, other, 0.0).tolist() == [start.tolist(), goal.tolist()]
+
+
+def test_a_route_keeps_to_open_sky_where_it_can():
+    """South of the deck to north of it, both in the open: not through the deck's shadow,
+    where no fix is (low under the deck, where the sky's sides still give one, or round)."""
+    from mission.world.routes import route_map
+
+    world = KnownWorld(load_scenario("along"))
+    routes = route_map(world)
+    south, north = np.array([-8.0, -8.0, 6.0]), np.array([-8.0, 8.0, 6.0])
+    assert not routes.in_shadow(np.vstack([south, north])).any()
+    route = routes.route(south, north)
+    assert not routes.in_shadow(_sampled(route)).any()
+    flat = RouteMap(routes.grid, routes.proximity, routes.margin_m)  # no shadow: under it
+    assert routes.in_shadow(_sampled(flat.route(south, north))).any()
