@@ -1,7 +1,8 @@
 """What dynamic roles (issue 33) cost the control cycle: a detached Piers AC run with the
 dynamic policy (the work UAV's own fix judged, the look-ahead, releases, recalls and routes)
-against the same run with fixed roles, alternately in one process, so both see the same
-machine. Piers' first cycles fly the open sky, release supports and recall them."""
+against the paper's cycle (fixed roles, no inspections: nothing of the roles runs), on the
+same waypoints, alternately in one process, so both see the same machine. Piers' first
+cycles fly the open sky, release supports and recall them."""
 
 from __future__ import annotations
 
@@ -21,8 +22,8 @@ def bench_roles(cycles: int = 240, repeats: int = 3) -> list[BenchResult]:
     from mission.world.model import World
 
     worlds = {
-        policy: World(load_scenario("piers", {"roles.policy": policy}))
-        for policy in ("fixed", "dynamic")
+        "fixed": World(load_scenario("piers", {"task.inspections": []})),
+        "dynamic": World(load_scenario("piers", {"roles.policy": "dynamic"})),
     }
     plan = read_plan(worlds["fixed"].scenario)
     waypoints = {"work": plan.work, **{f"support-{n + 1}": p for n, p in enumerate(plan.supports)}}

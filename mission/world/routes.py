@@ -118,9 +118,19 @@ class RouteMap:
 
     def structure_between(self, a: np.ndarray, b: np.ndarray, margin_m: float) -> bool:
         """Whether the straight way from ``a`` to ``b`` comes within ``margin_m`` of the
-        structure (the ground not counted; sampled every quarter voxel)."""
+        structure (the ground not counted), sampled every quarter voxel: boxes by their
+        distance in closed form, a mesh file by its closest points."""
         count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
         points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
+        low, high = self.proximity.low, self.proximity.high
+        if len(low):
+            outside = np.maximum(
+                np.maximum(low[None] - points[:, None], points[:, None] - high[None]), 0
+            )
+            if np.any(np.einsum("pbk,pbk->pb", outside, outside) < margin_m**2):
+                return True
+        if not self.proximity.has_file_mesh:
+            return False
         return bool(np.any(self.proximity.distance(points) < margin_m))
 
     def _without(self, keep_off: Obstacles, ends: tuple[int, int]):

@@ -74,3 +74,14 @@ def test_a_route_keeps_to_open_sky_where_it_can():
     assert not routes.in_shadow(_sampled(route)).any()
     flat = RouteMap(routes.grid, routes.proximity, routes.margin_m)  # no shadow: under it
     assert routes.in_shadow(_sampled(flat.route(south, north))).any()
+
+
+def test_the_structure_in_the_way_is_what_the_distances_say(routes):
+    """The quick box test equals the structure's distance at the same samples."""
+    rng = np.random.default_rng(1)
+    for _ in range(300):
+        a, b = rng.uniform([-25, -20, 0], [25, 20, 20], (2, 3))
+        count = max(2, int(np.ceil(np.linalg.norm(b - a) / 0.25)) + 1)
+        points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
+        near = bool(np.any(routes.proximity.distance(points) < 0.5))
+        assert routes.structure_between(a, b, 0.5) == near
