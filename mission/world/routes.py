@@ -4,10 +4,10 @@ The formation's MPC plans a support locally, around the work UAV; a support flyi
 inspection waypoint (on the far side of a pier, on top of the deck) needs a way around the
 structure first. The map G's voxel grid is the graph: a voxel is free where its centre is at
 least ``margin_m`` from the structure and the ground, and free voxels that touch (26
-neighbours) are joined by their centres' distance, ten times that where either voxel has no
-GNSS fix (a support routed through the deck's shadow flies on a drifting estimate: a route
-keeps to open sky where it can). Dijkstra's algorithm (scipy's csgraph) gives the least
-costly way; the voxel path is then pulled straight: each corner is skipped where
+neighbours) are joined by their centres' distance times a cost per metre: more where the
+GNSS is poor (a support routed where its fixes are poor or absent flies on a drifting
+estimate: a route keeps to good GNSS where it can). Dijkstra's algorithm (scipy's csgraph)
+gives the least costly way; the voxel path is then pulled straight: each corner is skipped where
 the segment past it keeps the margin (sampled every quarter voxel). A route can also keep off
 balls around other UAVs (their voxels taken out of the graph for that route).
 """
@@ -24,7 +24,7 @@ from mission.world.grid import VoxelGrid
 from mission.world.model import KnownWorld
 from mission.world.proximity import StructureProximity
 
-SHADOW_COST = 10.0  # a metre without a GNSS fix costs as much as ten in the open
+POOR_GNSS_COST = 10.0  # the most a metre costs: without a fix, or sigma_0 ten times good
 NEIGHBOURS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)])
 
 
@@ -36,14 +36,15 @@ class RouteMap:
         grid: VoxelGrid,
         proximity: StructureProximity,
         margin_m: float,
-        shadow: np.ndarray | None = None,
+        cost: np.ndarray | None = None,
     ) -> None:
         self.grid, self.proximity, self.margin_m = grid, proximity, margin_m
         centres = grid.centers().reshape(-1, 3)
         self.free = proximity.clearance(centres) >= margin_m
         self.centres = centres
-        # voxels without a GNSS fix: an edge touching one costs SHADOW_COST times its length
-        self.shadow = np.zeros(len(centres), bool) if shadow is None else shadow.reshape(-1)
+        # each voxel's cost per metre (1: good GNSS; up to POOR_GNSS_COST): an edge costs its
+        # length times the dearer of its two voxels'
+        self.cost = np.ones(len(centres)) if cost is None else np.asarray(cost, float).reshape(-1)
         self.graph = self._graph()
 
     def _graph(self):
@@ -61,9 +62,8 @@ class RouteMap:
             keep = self.free[here] & self.free[shifted]
             rows.append(here[keep])
             cols.append(shifted[keep])
-            dark = self.shadow[here[keep]] | self.shadow[shifted[keep]]
-            length = self.grid.voxel_m * np.linalg.norm(offset)
-            weights.append(np.where(dark, SHADOW_COST * length, length))
+            dearer = np.maximum(self.cost[here[keep]], self.cost[shifted[keep]])
+            weights.append(dearer * self.grid.voxel_m * np.linalg.norm(offset))
         n = self.grid.n_voxels
         return coo_matrix(
             (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
@@ -154,7 +154,7 @@ class RouteMap:
 
     def _clear(self, a: np.ndarray, b: np.ndarray, keep_off: Obstacles) -> bool:
         """The segment keeps the margin, or at least what its ends have of it, stays off the
-        obstacles (but where its ends are) and, from open sky to open sky, out of the shadow."""
+        obstacles (but where its ends are) and out of GNSS poorer than at its ends."""
         count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
         points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
         clearance = self.proximity.clearance(points)
@@ -164,13 +164,13 @@ class RouteMap:
         inside = keep_off.covers(points)
         if np.any(inside & ~inside[0] & ~inside[-1]):
             return False
-        dark = self.in_shadow(points)  # open sky to open sky stays in the open
-        return bool(dark[0] or dark[-1] or not np.any(dark))
+        costs = self.cost_at(points)  # never through poorer GNSS than at its ends
+        return bool(costs.max() <= max(costs[0], costs[-1]))
 
-    def in_shadow(self, points: np.ndarray) -> np.ndarray:
-        """Which points lie in a voxel without a GNSS fix."""
+    def cost_at(self, points: np.ndarray) -> np.ndarray:
+        """The cost per metre of the voxel of each point."""
         index = self.grid.index_of(points)
-        return self.shadow[np.ravel_multi_index(tuple(index.T), self.grid.shape)]
+        return self.cost[np.ravel_multi_index(tuple(index.T), self.grid.shape)]
 
 
 def _walk_back(previous: np.ndarray, first: int, last: int) -> list[int] | None:
@@ -200,15 +200,17 @@ class Obstacles:
 def route_map(world: KnownWorld, sigma0: np.ndarray | None = None) -> RouteMap:
     """Routes through the map's voxels that keep the clearance margin (at least a body's
     radius) widened by an estimate's allowance from the structure and the ground, and keep to
-    open sky where they can (``sigma0``: the world's sigma_0 map, if already computed; its
-    no-fix voxels are the shadow)."""
+    good GNSS where they can: a metre costs sigma_0 over ``roles.own_fix_max_sigma_m`` (a fix
+    the ground station would trust), at least 1 and at most ``POOR_GNSS_COST`` (``sigma0``:
+    the world's sigma_0 map, if already computed; no fix is its cap)."""
     control = world.scenario.control
     margin = max(control.clearance_m, world.scenario.vehicle.radius_m)
     if sigma0 is None:
         sigma0 = world.sigma0_map().sigma_m
+    good = world.scenario.roles.own_fix_max_sigma_m
     return RouteMap(
         world.map_grid(),
         StructureProximity(world.structure),
         margin + control.estimate_allowance_m,
-        np.asarray(sigma0) >= world.scenario.map.no_fix_sigma_m,
+        np.clip(np.asarray(sigma0) / good, 1.0, POOR_GNSS_COST),
     )

@@ -63,17 +63,18 @@ def test_a_route_keeps_off_another_uav(routes):
 
 def test_a_route_keeps_to_open_sky_where_it_can():
     """South of the deck to north of it, both in the open: not through the deck's shadow,
-    where no fix is (low under the deck, where the sky's sides still give one, or round)."""
+    where no fix is, nor where fixes are poor (low under the deck, where the sky's sides
+    still give good ones, or round)."""
     from mission.world.routes import route_map
 
     world = KnownWorld(load_scenario("along"))
     routes = route_map(world)
     south, north = np.array([-8.0, -8.0, 6.0]), np.array([-8.0, 8.0, 6.0])
-    assert not routes.in_shadow(np.vstack([south, north])).any()
+    assert routes.cost_at(np.vstack([south, north])).max() == 1.0
     route = routes.route(south, north)
-    assert not routes.in_shadow(_sampled(route)).any()
-    flat = RouteMap(routes.grid, routes.proximity, routes.margin_m)  # no shadow: under it
-    assert routes.in_shadow(_sampled(flat.route(south, north))).any()
+    assert routes.cost_at(_sampled(route)).max() == 1.0  # sigma_0 <= 0.3 m all the way
+    flat = RouteMap(routes.grid, routes.proximity, routes.margin_m)  # at any cost: under it
+    assert routes.cost_at(_sampled(flat.route(south, north))).max() == 10.0
 
 
 def test_the_structure_in_the_way_is_what_the_distances_say(routes):
