@@ -15,7 +15,9 @@ Each support is in one of three roles:
 With ``roles.policy: dynamic``, each cycle the work UAV's path ahead is looked at
 (:mod:`ground_station.roles.lookahead`): where its own fix is expected trustworthy for
 ``release_clear_s`` or more (or to the end of its task), supports with inspections left are
-released, all but ``keep_in_formation`` (the farthest from the work UAV first); where it is
+released, all but ``keep_in_formation`` (the farthest from the work UAV first), each only if
+it can reach its next inspection waypoint before it would be recalled (the straight way at
+its speed within the look-ahead less ``recall_clear_s``); where it is
 expected for less than ``recall_clear_s``, every inspecting support is recalled. Between the
 two nothing changes: a path along a shadow's edge recalls once and releases again only with
 ``release_clear_s`` of open sky ahead (the hysteresis). With ``fixed`` (the paper), supports
@@ -51,6 +53,7 @@ from ground_station.support_mpc.mpc import SupportPlan
 HANDOVER_M = 2.0  # a returning support this close to its formation waypoint rejoins
 CORNER_TOL_M = 0.3  # a route's corner (not an inspection waypoint) is passed this close
 REROUTE_AFTER = 10  # cycles held giving way before a route round the others is sought
+LOOK_AHEAD_FACTOR = 2.0  # the path is looked at this many release_clear_s ahead
 TRANSIT_M = 4.0  # a formation support farther from its waypoint, behind the structure, is routed
 
 
@@ -80,7 +83,7 @@ def allocate(state: StationState, context: RunContext, allocation: Allocation) -
             context.g,
             roles.own_fix_max_sigma_m,
             context.scenario.control.s_max_work_m_s,
-            roles.release_clear_s,
+            LOOK_AHEAD_FACTOR * roles.release_clear_s,
         )
     else:
         allocation.clear_s = math.inf if state.completed else 0.0
@@ -115,10 +118,17 @@ def _release(state: StationState, context: RunContext, allocation: Allocation) -
     keep = 0 if state.completed else context.scenario.roles.keep_in_formation
     limit = len(state.yhat) - keep
     out = sum(1 for s in allocation.supports.values() if s.role == INSPECTING)
+    # only a support that can reach its next inspection waypoint before it would be recalled
+    # (by the straight way at its speed: no route can be shorter)
+    available_s = allocation.clear_s - context.scenario.roles.recall_clear_s
+    speed = context.scenario.control.s_max_support_m_s
     candidates = [
         n
         for n, s in allocation.supports.items()
-        if s.role != INSPECTING and s.next_inspection < len(context.inspections[n])
+        if s.role != INSPECTING
+        and s.next_inspection < len(context.inspections[n])
+        and np.linalg.norm(context.inspections[n][s.next_inspection] - state.yhat[n]) / speed
+        <= available_s
     ]
     candidates.sort(key=lambda n: (-float(np.linalg.norm(state.yhat[n] - state.xhat)), n))
     for name in candidates[: max(0, limit - out)]:

@@ -1,9 +1,10 @@
-"""Dynamic roles in a real run (issue 33), the first 120 s of the piers scenario: the ground
-station uses the work UAV's own fix in the open (at the west pier and the deck's south edge),
-each where G expects at most 0.3 m, and the summary counts the verdicts; it releases supports
-to their inspections while the path ahead is open, and has them all back in the formation
-before the work UAV's fix fails under the deck (a support routed round the structure to its
-formation waypoint may be on its way then)."""
+"""Dynamic roles in a real run (issue 33), the piers scenario to the end: the ground station
+uses the work UAV's own fix in the open (at the piers and the deck's edges), each where G
+expects at most 0.3 m, and the summary counts the verdicts; it releases supports to their
+inspections while the path ahead is open, never has one away from the formation (inspecting,
+or on its way back from an inspection) while the work UAV's fix fails or it is blind (a
+support routed round the structure to its formation waypoint may be on its way then), and
+every inspection is done."""
 
 from __future__ import annotations
 
@@ -20,22 +21,22 @@ OFF_SKY = ("no fix", "shadow", "map")  # the verdicts of a work UAV where its fi
 def test_in_the_open_supports_inspect_and_are_back_before_the_shadow(tmp_path):
     scenario = tmp_path / "piers-dynamic.yaml"
     scenario.write_text(
-        "extends: piers\nname: piers-dynamic\nroles: {policy: dynamic}\nrun: {timeout_s: 120}\n"
+        "extends: piers\nname: piers-dynamic\nroles: {policy: dynamic}\n"
     )
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     records = [json.loads(line) for line in (tmp_path / "run" / "records.jsonl").open()]
     verdicts = [r["own_fix"] for r in records]
     used = [v for v in verdicts if v["used"]]
-    assert len(used) > len(records) / 3  # the west pier's face and the south edge: open sky
+    assert len(used) > len(records) / 4  # the piers' faces and the deck's edges: open sky
     assert all(v["sigma_m"] <= 0.3 for v in used)
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     counts = summary["diagnostics"]["own_fix_cycles"]
     assert counts["used"] == len(used) and sum(counts.values()) == len(records)
 
     roles = [r["roles"]["roles"] for r in records]
-    assert any("inspecting" in r.values() for r in roles[:10])  # released at the start
-    assert any(n > 0 for n in records[-1]["roles"]["next_inspection"].values())  # and inspected
+    assert any("inspecting" in r.values() for r in roles)
+    assert records[-1]["roles"]["next_inspection"] == {f"support-{n}": 4 for n in (1, 2, 3)}
     assert sum(r["own_fix"]["reason"] == "no fix" for r in records) > 10  # under the deck
     away = _away_from_inspections(roles)
     for record, out in zip(records, away):
@@ -45,7 +46,8 @@ def test_in_the_open_supports_inspect_and_are_back_before_the_shadow(tmp_path):
     # the summary's roles and the 3-D view's
     block = summary["roles"]
     assert block["policy"] == "dynamic" and block["support_minutes"]["inspecting"] > 0
-    assert block["role_switches"] >= 2 and block["all_done_s"] is None  # stopped at 120 s
+    assert block["role_switches"] >= 6  # each released and back at least once
+    assert block["all_done_s"] == summary["completion_time_s"] == records[-1]["t"]
     saved = tmp_path / "run.rrd"
     assert mission("view", str(tmp_path / "run"), "--save", str(saved)).returncode == 0
     from mission.viewer.frame import ROLE_LEVELS, role_colour
