@@ -26,8 +26,9 @@ inspection waypoints returns to the formation (or, the task complete, holds ther
 
 A route keeps off the other UAVs' estimates by the separation widened by two estimates'
 allowance. A routed support steps along it by at most its reach; where that step would bring
-it that close to another UAV's estimate, and closer, it steps straight away from that UAV
-instead, or holds where away is toward the structure (it gives way: the work UAV and the
+it that close to another UAV's estimate, and closer, it steps away from that UAV instead
+(straight away, or up, down or sideways where straight away closes on the structure; it
+holds only where every way does: it gives way: the work UAV and the
 formation's MPCs plan around it from its estimate and its predicted route); after
 ``REROUTE_AFTER`` such cycles it is routed afresh round the others where they are then.
 """
@@ -189,11 +190,15 @@ def _route_home(state: StationState, context: RunContext, name: str) -> np.ndarr
 
 def _routed(state: StationState, context: RunContext, name: str, goal: np.ndarray) -> np.ndarray:
     """The corners after the support's estimate of a route to ``goal`` that keeps off the
-    other UAVs' estimates by the separation (the straight way where none is found)."""
+    other UAVs' estimates by the separation; where they close every way, one that does not
+    (it gives way as it goes); where the structure does, none: it holds."""
     assert context.routes is not None
+    start = state.yhat[name]
     others = np.array([state.xhat, *(p for n, p in state.yhat.items() if n != name)])
-    route = context.routes.route(state.yhat[name], goal, others, _crowding_m(context))
-    return np.array([goal]) if route is None else route[1:]
+    route = context.routes.route(start, goal, others, _crowding_m(context))
+    if route is None:
+        route = context.routes.route(start, goal)
+    return np.array([start]) if route is None else route[1:]
 
 
 def _crowding_m(context: RunContext) -> float:
@@ -236,8 +241,10 @@ def _along(start: np.ndarray, route: np.ndarray | None, reach: float, steps: int
 
 
 def _give_way(state, context, name, command) -> np.ndarray | None:
-    """A step straight away from the nearest UAV whose separation ``command`` would break
-    (and come closer), or None."""
+    """A step away from the nearest UAV whose separation ``command`` would break (and come
+    closer), or None: straight away, else the first of away-and-up, away-and-down, sideways
+    and straight up or down that moves away from it without closing on the structure inside
+    the route margin; where none does, it holds."""
     control = context.scenario.control
     needed = _crowding_m(context)
     if needed <= 0:
@@ -253,11 +260,23 @@ def _give_way(state, context, name, command) -> np.ndarray | None:
     if not crowded:
         return None
     nearest = min(crowded, key=lambda o: float(np.linalg.norm(yhat - o)))
-    away = yhat - nearest
+    away = _unit(yhat - nearest)
+    side = _unit(np.cross(away, UP)) if abs(away[2]) < 0.99 else np.array([1.0, 0.0, 0.0])
     reach = control.s_max_support_m_s * control.t_cont_s
-    step = yhat + away / max(float(np.linalg.norm(away)), 1e-9) * reach
     assert context.routes is not None
-    after, now = context.routes.proximity.clearance(np.vstack([step, yhat]))
-    if after < context.routes.margin_m and after < now:  # away would be toward the structure
-        return yhat.copy()
-    return step
+    now = float(context.routes.proximity.clearance(yhat[None])[0])
+    for direction in (away, away + UP, away - UP, side, -side, UP, -UP):
+        step = yhat + _unit(direction) * reach
+        if np.linalg.norm(step - nearest) <= np.linalg.norm(yhat - nearest):
+            continue
+        after = float(context.routes.proximity.clearance(step[None])[0])
+        if after >= context.routes.margin_m or after > now:  # never closer inside the margin
+            return step
+    return yhat.copy()
+
+
+UP = np.array([0.0, 0.0, 1.0])
+
+
+def _unit(vector: np.ndarray) -> np.ndarray:
+    return vector / max(float(np.linalg.norm(vector)), 1e-9)

@@ -24,7 +24,8 @@ from mission.world.grid import VoxelGrid
 from mission.world.model import KnownWorld
 from mission.world.proximity import StructureProximity
 
-POOR_GNSS_COST = 10.0  # the most a metre costs: without a fix, or sigma_0 ten times good
+POOR_GNSS_COST = 100.0  # the most a metre costs: without a fix, or sigma_0 ten times good
+ROUTE_EXTRA_M = 0.5  # a routed support flies without the MPC's map: this much wider a berth
 NEIGHBOURS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)])
 
 
@@ -153,12 +154,19 @@ class RouteMap:
         return np.array(kept)
 
     def _clear(self, a: np.ndarray, b: np.ndarray, keep_off: Obstacles) -> bool:
-        """The segment keeps the margin, or at least what its ends have of it, stays off the
-        obstacles (but where its ends are) and out of GNSS poorer than at its ends."""
+        """The segment keeps the margin; an end inside it is left (or neared) gaining (or
+        losing) clearance at least half as fast as the way goes; it stays off the obstacles
+        (but where its ends are) and out of GNSS poorer than at its ends."""
         count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
-        points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
+        fractions = np.linspace(0.0, 1.0, count)
+        points = a + (b - a) * fractions[:, None]
         clearance = self.proximity.clearance(points)
-        needed = min(self.margin_m, float(clearance[0]), float(clearance[-1]))
+        length = float(np.linalg.norm(b - a))
+        from_a, from_b = fractions * length, (1.0 - fractions) * length
+        needed = np.minimum(
+            self.margin_m,
+            np.minimum(clearance[0] + 0.5 * from_a, clearance[-1] + 0.5 * from_b),
+        )
         if not np.all(clearance >= needed - 1e-9):
             return False
         inside = keep_off.covers(points)
@@ -199,10 +207,11 @@ class Obstacles:
 
 def route_map(world: KnownWorld, sigma0: np.ndarray | None = None) -> RouteMap:
     """Routes through the map's voxels that keep the clearance margin (at least a body's
-    radius) widened by an estimate's allowance from the structure and the ground, and keep to
-    good GNSS where they can: a metre costs sigma_0 over ``roles.own_fix_max_sigma_m`` (a fix
-    the ground station would trust), at least 1 and at most ``POOR_GNSS_COST`` (``sigma0``:
-    the world's sigma_0 map, if already computed; no fix is its cap)."""
+    radius) widened by an estimate's allowance and ``ROUTE_EXTRA_M`` from the structure and
+    the ground, and keep to good GNSS where they can: a metre costs the square of sigma_0 over
+    ``roles.own_fix_max_sigma_m`` (a fix the ground station would trust), at least 1 and at
+    most ``POOR_GNSS_COST`` (``sigma0``: the world's sigma_0 map, if already computed; no fix
+    is its cap)."""
     control = world.scenario.control
     margin = max(control.clearance_m, world.scenario.vehicle.radius_m)
     if sigma0 is None:
@@ -211,6 +220,6 @@ def route_map(world: KnownWorld, sigma0: np.ndarray | None = None) -> RouteMap:
     return RouteMap(
         world.map_grid(),
         StructureProximity(world.structure),
-        margin + control.estimate_allowance_m,
-        np.clip(np.asarray(sigma0) / good, 1.0, POOR_GNSS_COST),
+        margin + control.estimate_allowance_m + ROUTE_EXTRA_M,
+        np.clip((np.asarray(sigma0) / good) ** 2, 1.0, POOR_GNSS_COST),
     )
