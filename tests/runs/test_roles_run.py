@@ -47,7 +47,7 @@ def test_in_the_open_supports_inspect_and_are_back_before_the_shadow(tmp_path):
     block = summary["roles"]
     assert block["policy"] == "dynamic" and block["support_minutes"]["inspecting"] > 0
     assert block["role_switches"] >= 6  # each released and back at least once
-    assert block["all_done_s"] == summary["completion_time_s"] == records[-1]["t"]
+    assert block["all_done_s"] == records[-1]["t"] >= summary["completion_time_s"]
     saved = tmp_path / "run.rrd"
     assert mission("view", str(tmp_path / "run"), "--save", str(saved)).returncode == 0
     from mission.viewer.frame import ROLE_LEVELS, role_colour
