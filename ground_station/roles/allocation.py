@@ -5,12 +5,13 @@ Each support is in one of three roles:
 - ``formation``: planned by its MPC around the work UAV (the paper's role);
 - ``inspecting``: flying a route (:mod:`mission.world.routes`) to its next inspection
   waypoint (``task.inspections``), then the next, until it has reached them all;
-- ``returning``: flying a route back to its formation waypoint; within ``HANDOVER_M`` of it
-  (or at the route's end) its MPC takes it again. A formation support whose waypoint lies
-  behind the structure (the straight way to it comes within the clearance margin of it, and
-  it is more than ``TRANSIT_M`` away) is sent the same way: the MPC plans locally, and a pier
-  or the deck between it and its waypoint can hold it (in the piers scenario one such
-  support, GNSS-denied under the deck, drifted into the east pier).
+- ``returning``: flying a route back to its formation waypoint; within ``TRANSIT_M`` of it
+  with no structure in the straight way (or at the route's end) its MPC takes it again. A
+  formation support whose waypoint lies behind the structure (the straight way to it comes
+  within the clearance margin of it, and it is more than ``TRANSIT_M`` away) is sent the
+  same way: the MPC plans locally, and a pier or the deck between it and its waypoint can
+  hold it (in the piers scenario one such support, GNSS-denied under the deck, drifted into
+  the east pier).
 
 With ``roles.policy: dynamic``, each cycle the work UAV's path ahead is looked at
 (:mod:`ground_station.roles.lookahead`): where its own fix is expected trustworthy for
@@ -30,7 +31,9 @@ it that close to another UAV's estimate, and closer, it steps away from that UAV
 (straight away, or up, down or sideways where straight away closes on the structure; it
 holds only where every way does: it gives way: the work UAV and the
 formation's MPCs plan around it from its estimate and its predicted route); after
-``REROUTE_AFTER`` such cycles it is routed afresh round the others where they are then.
+``REROUTE_AFTER`` such cycles since its route was planned it is routed afresh round the
+others where they are then, and so it is where a step aside left it off its route with the
+straight way back cutting the margin.
 """
 
 from __future__ import annotations
@@ -51,7 +54,6 @@ from ground_station.run_context import RunContext
 from ground_station.state import StationState
 from ground_station.support_mpc.mpc import SupportPlan
 
-HANDOVER_M = 2.0  # a returning support this close to its formation waypoint rejoins
 CORNER_TOL_M = 0.3  # a route's corner (not an inspection waypoint) is passed this close
 REROUTE_AFTER = 10  # cycles held giving way before a route round the others is sought
 LOOK_AHEAD_FACTOR = 2.0  # the path is looked at this many release_clear_s ahead
@@ -103,7 +105,7 @@ def _send_round_the_structure(
     structure in the straight way (within the clearance margin of it) is routed there
     (``returning``): its MPC plans locally and can be held behind a pier or the deck."""
     assert context.routes is not None
-    margin = max(context.scenario.control.clearance_m, context.scenario.vehicle.radius_m)
+    margin = _transit_margin(context)
     for name, support in allocation.supports.items():
         if support.role != FORMATION:
             continue
@@ -145,6 +147,9 @@ def _progress(state: StationState, context: RunContext, allocation: Allocation) 
         yhat = state.yhat[name]
         if support.held >= REROUTE_AFTER and support.route is not None:  # a way round them
             support.route, support.held = _routed(state, context, name, support.route[-1]), 0
+        elif support.route is not None and not context.routes.leads_on(yhat, support.route[0]):
+            # off its route (it gave way): the straight way back to it would cut the margin
+            support.route, support.held = _routed(state, context, name, support.route[-1]), 0
         while support.route is not None and len(support.route) > 1:
             if np.linalg.norm(support.route[0] - yhat) >= CORNER_TOL_M:
                 break
@@ -162,16 +167,31 @@ def _progress(state: StationState, context: RunContext, allocation: Allocation) 
         elif support.role == RETURNING:
             home = _formation_waypoint(state, context, name)
             at_end = np.linalg.norm(support.route[-1] - yhat) < CORNER_TOL_M
-            if np.linalg.norm(home - yhat) < HANDOVER_M or at_end:
+            if _mpc_can_take(context, yhat, home) or at_end:
                 _set(allocation, name, FORMATION, None)
                 state.warm.pop(name, None)  # its MPC starts afresh from where it is
+
+
+def _mpc_can_take(context: RunContext, yhat: np.ndarray, home: np.ndarray) -> bool:
+    """Within ``TRANSIT_M`` of its formation waypoint with no structure in the straight way
+    (the formation's other supports, which a routed support gives way to, can keep it
+    metres from its waypoint)."""
+    assert context.routes is not None
+    if np.linalg.norm(home - yhat) >= TRANSIT_M:
+        return False
+    return not context.routes.structure_between(yhat, home, _transit_margin(context))
+
+
+def _transit_margin(context: RunContext) -> float:
+    control, vehicle = context.scenario.control, context.scenario.vehicle
+    return max(control.clearance_m, vehicle.radius_m)
 
 
 def _set(allocation: Allocation, name: str, role: str, route: np.ndarray | None) -> None:
     support = allocation.supports[name]
     if support.role != role:
         allocation.switches += 1
-    support.role, support.route = role, route
+    support.role, support.route, support.held = role, route, 0
 
 
 def _formation_waypoint(state: StationState, context: RunContext, name: str) -> np.ndarray:
@@ -223,7 +243,7 @@ def routed_plans(state: StationState, context: RunContext, allocation: Allocatio
         yhat = state.yhat[name]
         path = _along(yhat, support.route, reach, horizon)
         away = _give_way(state, context, name, path[0])
-        support.held = 0 if away is None else support.held + 1
+        support.held += away is not None  # since its route was planned
         if away is not None:
             path = np.repeat(away[None], horizon, axis=0)
         blocked = np.zeros(horizon, dtype=bool)

@@ -19,7 +19,7 @@ class SupportRole:
     role: str = FORMATION
     next_inspection: int = 0
     route: np.ndarray | None = None
-    held: int = 0  # cycles in a row it gave way
+    held: int = 0  # cycles it gave way since its route was planned
 
 
 @dataclass

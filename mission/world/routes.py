@@ -153,6 +153,12 @@ class RouteMap:
             i = j
         return np.array(kept)
 
+    def leads_on(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """Whether the straight way from ``a`` to a route's corner ``b`` is one a route could
+        take (the margin, GNSS no poorer than at its ends)."""
+        nobody = Obstacles(np.zeros((0, 3)), 0.0)
+        return self._clear(np.asarray(a, float), np.asarray(b, float), nobody)
+
     def _clear(self, a: np.ndarray, b: np.ndarray, keep_off: Obstacles) -> bool:
         """The segment keeps the margin; an end inside it is left (or neared) gaining (or
         losing) clearance at least half as fast as the way goes; it stays off the obstacles

@@ -2,7 +2,7 @@
 uses the work UAV's own fix in the open (at the piers and the deck's edges), each where G
 expects at most 0.3 m, and the summary counts the verdicts; it releases supports to their
 inspections while the path ahead is open, never has one away from the formation (inspecting,
-or on its way back from an inspection) while the work UAV's fix fails or it is blind (a
+or on its way back from an inspection) while the work UAV is in the shadow or blind (a
 support routed round the structure to its formation waypoint may be on its way then), and
 every inspection is done."""
 
@@ -14,15 +14,16 @@ import pytest
 
 from tests.processes import mission
 
-OFF_SKY = ("no fix", "shadow", "map")  # the verdicts of a work UAV where its fix fails
+# the verdicts of a work UAV in the deck's shadow ("map", G expecting poor GNSS, is also
+# given in the open, near multipath, and where the look-ahead, at the estimate, and the
+# verdict, at the fix, straddle a shadow's edge: a kept support still localizes it there)
+OFF_SKY = ("no fix", "shadow")
 
 
 @pytest.mark.slow
 def test_in_the_open_supports_inspect_and_are_back_before_the_shadow(tmp_path):
     scenario = tmp_path / "piers-dynamic.yaml"
-    scenario.write_text(
-        "extends: piers\nname: piers-dynamic\nroles: {policy: dynamic}\n"
-    )
+    scenario.write_text("extends: piers\nname: piers-dynamic\nroles: {policy: dynamic}\n")
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
     records = [json.loads(line) for line in (tmp_path / "run" / "records.jsonl").open()]
