@@ -49,7 +49,7 @@ from ground_station.roles.assignment import (
     Allocation,
     SupportRole,
 )
-from ground_station.roles.lookahead import clear_ahead_s
+from ground_station.roles.lookahead import clear_ahead_s, points_along
 from ground_station.run_context import RunContext
 from ground_station.state import StationState
 from ground_station.support_mpc.mpc import SupportPlan
@@ -254,10 +254,7 @@ def routed_plans(state: StationState, context: RunContext, allocation: Allocatio
 def _along(start: np.ndarray, route: np.ndarray | None, reach: float, steps: int) -> np.ndarray:
     """``steps`` positions a reach apart along the route's corners from ``start``."""
     corners = np.vstack([start[None], route]) if route is not None else start[None]
-    legs = np.linalg.norm(np.diff(corners, axis=0), axis=1)
-    ends = np.concatenate([[0.0], np.cumsum(legs)])
-    arcs = np.minimum(reach * np.arange(1, steps + 1), ends[-1])
-    return np.column_stack([np.interp(arcs, ends, corners[:, a]) for a in range(3)])
+    return points_along(corners, reach * np.arange(1, steps + 1))
 
 
 def _give_way(state, context, name, command) -> np.ndarray | None:

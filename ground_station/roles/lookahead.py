@@ -25,15 +25,19 @@ def path_ahead(xhat: np.ndarray, k: int, waypoints: np.ndarray, spacing_m: float
     """Points every ``spacing_m`` along xhat -> w_k -> ... -> the last waypoint, up to
     ``length_m`` of path, and whether the path ends within that length."""
     corners = np.vstack([np.asarray(xhat, dtype=float)[None], waypoints[k:]])
-    legs = np.linalg.norm(np.diff(corners, axis=0), axis=1)
-    ends = np.concatenate([[0.0], np.cumsum(legs)])
-    total = float(ends[-1])
-    reach = min(total, length_m)
-    arcs = np.arange(0.0, reach + 1e-9, spacing_m)
+    total = float(np.sum(np.linalg.norm(np.diff(corners, axis=0), axis=1)))
+    arcs = np.arange(0.0, min(total, length_m) + 1e-9, spacing_m)
     if total <= length_m and (len(arcs) == 0 or arcs[-1] < total):
         arcs = np.append(arcs, total)
-    points = np.column_stack([np.interp(arcs, ends, corners[:, axis]) for axis in range(3)])
-    return points, total <= length_m
+    return points_along(corners, arcs), total <= length_m
+
+
+def points_along(corners: np.ndarray, arcs: np.ndarray) -> np.ndarray:
+    """The points at the distances ``arcs`` along the polyline through ``corners`` (held at
+    its end beyond it)."""
+    legs = np.linalg.norm(np.diff(corners, axis=0), axis=1)
+    ends = np.concatenate([[0.0], np.cumsum(legs)])
+    return np.column_stack([np.interp(arcs, ends, corners[:, axis]) for axis in range(3)])
 
 
 def clear_ahead_s(

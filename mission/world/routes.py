@@ -22,7 +22,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from mission.world.grid import VoxelGrid
 from mission.world.model import KnownWorld
-from mission.world.proximity import StructureProximity
+from mission.world.proximity import StructureProximity, segment_points
 
 POOR_GNSS_COST = 100.0  # the most a metre costs: without a fix, or sigma_0 ten times good
 ROUTE_EXTRA_M = 0.5  # a routed support flies without the MPC's map: this much wider a berth
@@ -121,8 +121,7 @@ class RouteMap:
         """Whether the straight way from ``a`` to ``b`` comes within ``margin_m`` of the
         structure (the ground not counted), sampled every quarter voxel: boxes by their
         distance in closed form, a mesh file by its closest points."""
-        count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
-        points = a + (b - a) * np.linspace(0.0, 1.0, count)[:, None]
+        points = segment_points(a, b, self.grid.voxel_m / 4)
         low, high = self.proximity.low, self.proximity.high
         if len(low):
             outside = np.maximum(
@@ -163,12 +162,10 @@ class RouteMap:
         """The segment keeps the margin; an end inside it is left (or neared) gaining (or
         losing) clearance at least half as fast as the way goes; it stays off the obstacles
         (but where its ends are) and out of GNSS poorer than at its ends."""
-        count = max(2, int(np.ceil(np.linalg.norm(b - a) / (self.grid.voxel_m / 4))) + 1)
-        fractions = np.linspace(0.0, 1.0, count)
-        points = a + (b - a) * fractions[:, None]
+        points = segment_points(a, b, self.grid.voxel_m / 4)
         clearance = self.proximity.clearance(points)
-        length = float(np.linalg.norm(b - a))
-        from_a, from_b = fractions * length, (1.0 - fractions) * length
+        from_a = np.linalg.norm(points - a, axis=1)
+        from_b = float(np.linalg.norm(b - a)) - from_a
         needed = np.minimum(
             self.margin_m,
             np.minimum(clearance[0] + 0.5 * from_a, clearance[-1] + 0.5 * from_b),

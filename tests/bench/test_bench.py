@@ -144,3 +144,31 @@ def test_the_margins_rows_hold_the_run_with_margins_to_the_target(monkeypatch):
     assert rows["support_mpc_margins_median_ratio_paper_run"].ok is None  # a reference
     margins = [w.scenario.control.min_separation_m for [w] in posed.values()]
     assert margins == [2.0, 0.0]  # posed with the defaults first, then in the paper's form
+
+
+def test_every_benchmark_group_can_be_chosen_on_the_command_line():
+    import argparse
+
+    from mission.commands import bench as command
+
+    parser = argparse.ArgumentParser()
+    command.add_parser(parser.add_subparsers())
+    for name in bench.BENCHMARKS:
+        assert parser.parse_args(["bench", "--only", name]).only == [name]
+
+
+def test_the_roles_row_is_the_dynamic_median_over_the_papers(monkeypatch):
+    """Detached runs replaced by ones with known cycle times: fixed 10, 10, 12 ms a repeat;
+    dynamic 11 ms: the ratio of the medians over repeats, and the longest dynamic cycle."""
+    from mission.bench import detached, roles
+
+    def fake(world, waypoints, adaptive, seed, max_cycles):
+        dynamic = world.scenario.roles.policy == "dynamic"
+        times = [11.0, 11.0, 40.0] if dynamic else [10.0, 10.0, 12.0]
+        return SimpleNamespace(outputs=[SimpleNamespace(cycle_ms=t) for t in times])
+
+    monkeypatch.setattr(detached, "run_detached", fake)
+    ratio, longest = roles.bench_roles(cycles=3, repeats=2)
+    assert ratio.name == "dynamic_roles_cycle_ratio" and ratio.value == pytest.approx(1.1)
+    assert ratio.ok is True
+    assert longest.value == 40.0 and longest.ok is None
