@@ -22,7 +22,7 @@ give none: the work UAV is then not blind.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,6 +42,9 @@ class OwnFix:
     reason: str
     sigma_m: float | None = None
     distance_sigmas: float | None = None
+    # the supports' relative estimate's covariance where the verdict reached it (what
+    # combined_estimate weighs the fix against; not recorded)
+    relative_cov: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     @property
     def used(self) -> bool:
@@ -64,8 +67,8 @@ def relative_covariance(fusion: FusionResult) -> np.ndarray | None:
     consistent supports' information (None when blind)."""
     if fusion.xhat is None or not fusion.densities:
         return None
-    information = sum(np.linalg.inv(d.factor @ d.factor.T) for d in fusion.densities)
-    return np.linalg.inv(information)
+    inverses = np.linalg.inv(np.array([d.factor @ d.factor.T for d in fusion.densities]))
+    return np.linalg.inv(sum(inverses))
 
 
 def own_covariance(sigma_m: float) -> np.ndarray:
@@ -83,8 +86,7 @@ def judge(
     """The verdict on ``fix`` (ENU; None without a 3-D fix) for this cycle."""
     if fix is None:
         return OwnFix("no fix")
-    has_fix, _ = world.gnss.sigma_gnss(fix[None])
-    if not has_fix[0]:
+    if not world.gnss.has_fix(fix[None])[0]:
         return OwnFix("shadow")
     sigma = float(g.smoothed(fix[None])[0])
     if sigma > settings.own_fix_max_sigma_m:
@@ -97,13 +99,13 @@ def judge(
     distance = float(np.sqrt(gap @ np.linalg.solve(combined, gap)))
     if distance > settings.own_fix_agreement_sigmas:
         return OwnFix("disagrees", sigma, distance)
-    return OwnFix(USED, sigma, distance)
+    return OwnFix(USED, sigma, distance, covariance)
 
 
 def combined_estimate(fix: np.ndarray, verdict: OwnFix, fusion: FusionResult) -> np.ndarray:
     """The work UAV's estimate from a trusted ``fix``: with the relative estimate by their
     information, or the fix alone where the supports give none."""
-    covariance = relative_covariance(fusion)
+    covariance = verdict.relative_cov
     if covariance is None:
         return np.asarray(fix, dtype=float).copy()
     assert verdict.sigma_m is not None and fusion.xhat is not None

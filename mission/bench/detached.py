@@ -7,6 +7,7 @@ BlueSky's detached node runs a simulation without a network. Used by the benchma
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +37,24 @@ def run_detached(
     max_cycles: int,
 ) -> DetachedRun:
     """Run up to ``max_cycles`` control cycles (or to completion)."""
+    outputs, truth, completed = [], [], False
+    for output, work_truth, completed in detached_cycles(
+        world, waypoints, adaptive, seed, max_cycles
+    ):
+        outputs.append(output)
+        truth.append(work_truth)
+    return DetachedRun(outputs, np.array(truth), completed)
+
+
+def detached_cycles(
+    world: World,
+    waypoints: dict[str, np.ndarray],
+    adaptive: bool,
+    seed: int,
+    max_cycles: int,
+) -> Iterator[tuple[CycleOutput, np.ndarray, bool]]:
+    """Each cycle as it is run: its output, the work UAV's true position when it began, and
+    whether the work UAV's task is complete (two runs can be stepped in turn)."""
     scenario = world.scenario
     control = scenario.control
     context, state = build_run_context(world.known(), waypoints, adaptive, seed)
@@ -46,7 +65,6 @@ def run_detached(
         name: control.s_max_work_m_s if name == "work" else control.s_max_support_m_s
         for name in waypoints
     }
-    outputs, truth = [], []
     for _ in range(max_cycles):
         work_truth = vehicles["work"].truth
         reports = []
@@ -61,8 +79,7 @@ def run_detached(
             fix = world.gnss.sample_fix(work_truth, own_rng, world.zone_offset(work_truth[None])[0])
             work_fix = fix.position_m if fix.has_fix else None
         output = complete_cycle(state, control_cycle(state, reports, context, work_fix), context)
-        outputs.append(output)
-        truth.append(work_truth.copy())
+        yield output, work_truth.copy(), state.completed
         if not output.blind:  # blind, the work UAV holds on its own dead reckoning
             vehicles["work"].set_estimate(state.xhat)
         vehicles["work"].target = output.work_target
@@ -73,4 +90,3 @@ def run_detached(
             vehicle.step(control.t_cont_s, speed[name], rng, scenario.vehicle.tracking_noise_m)
         if state.completed and not inspections_left(state.allocation, context):
             break
-    return DetachedRun(outputs, np.array(truth), state.completed)

@@ -141,6 +141,10 @@ class GnssModel:
         geometry = self.geometry(points)
         return geometry.has_fix, self.settings.sigma_uere_m**2 * geometry.cov_geom
 
+    def has_fix(self, points: np.ndarray) -> np.ndarray:
+        """(N,) whether a receiver at each point has a 3-D fix."""
+        return self.geometry_from_visibility(self.visibility(points)).has_fix
+
     def sigma0(self, points: np.ndarray) -> np.ndarray:
         """sqrt(tr Sigma_GNSS) = sigma_UERE * PDOP at each point (NaN without a fix)."""
         return self.settings.sigma_uere_m * self.geometry(points).pdop

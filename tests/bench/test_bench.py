@@ -157,18 +157,26 @@ def test_every_benchmark_group_can_be_chosen_on_the_command_line():
         assert parser.parse_args(["bench", "--only", name]).only == [name]
 
 
-def test_the_roles_row_is_the_dynamic_median_over_the_papers(monkeypatch):
-    """Detached runs replaced by ones with known cycle times: fixed 10, 10, 12 ms a repeat;
-    dynamic 11 ms: the ratio of the medians over repeats, and the longest dynamic cycle."""
+def test_the_roles_row_is_the_median_of_the_paired_runs_ratios(monkeypatch):
+    """Detached runs replaced by ones with known cycle times, a pair per repeat: the ratio of
+    each pair's medians (11/10, 12/10, 30/20), their median, and the longest dynamic cycle;
+    the two runs of a pair are stepped in turn."""
     from mission.bench import detached, roles
 
-    def fake(world, waypoints, adaptive, seed, max_cycles):
-        dynamic = world.scenario.roles.policy == "dynamic"
-        times = [11.0, 11.0, 40.0] if dynamic else [10.0, 10.0, 12.0]
-        return SimpleNamespace(outputs=[SimpleNamespace(cycle_ms=t) for t in times])
+    fixed = iter([[10.0, 10.0, 12.0], [10.0, 9.0, 11.0], [20.0, 20.0, 20.0]])
+    dynamic = iter([[11.0, 11.0, 40.0], [12.0, 12.0, 12.0], [30.0, 30.0, 30.0]])
+    order = []
 
-    monkeypatch.setattr(detached, "run_detached", fake)
-    ratio, longest = roles.bench_roles(cycles=3, repeats=2)
-    assert ratio.name == "dynamic_roles_cycle_ratio" and ratio.value == pytest.approx(1.1)
-    assert ratio.ok is True
+    def fake(world, waypoints, adaptive, seed, max_cycles):
+        policy = world.scenario.roles.policy
+        times = next(dynamic if policy == "dynamic" else fixed)
+        for t in times:
+            order.append(policy)
+            yield SimpleNamespace(cycle_ms=t), None, False
+
+    monkeypatch.setattr(detached, "detached_cycles", fake)
+    ratio, longest = roles.bench_roles(cycles=3, repeats=3)
+    assert ratio.name == "dynamic_roles_cycle_ratio" and ratio.value == pytest.approx(1.2)
+    assert ratio.ok is False
     assert longest.value == 40.0 and longest.ok is None
+    assert order[:4] == ["fixed", "dynamic", "fixed", "dynamic"]

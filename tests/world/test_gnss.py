@@ -81,6 +81,11 @@ def test_point_under_the_deck_has_no_fix(along_world):
     open_pdop = along_world.gnss.geometry(OPEN_SKY_POINT[None]).pdop[0]
     # Near the deck edge a fix may survive, but far worse than in the open.
     assert not geometry.has_fix[1] or geometry.pdop[1] > 2 * open_pdop
+    points = np.array([[0.0, 0.0, 6.0], OPEN_SKY_POINT, [0.0, -4.0, 6.0]])
+    np.testing.assert_array_equal(
+        along_world.gnss.has_fix(points), along_world.gnss.geometry(points).has_fix
+    )
+    assert along_world.gnss.has_fix(points).tolist()[:2] == [False, True]
 
 
 def test_fix_noise_has_sigma_gnss_covariance(along_world):
