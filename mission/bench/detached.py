@@ -38,11 +38,10 @@ def run_detached(
 ) -> DetachedRun:
     """Run up to ``max_cycles`` control cycles (or to completion)."""
     outputs, truth, completed = [], [], False
-    for output, work_truth, completed in detached_cycles(
-        world, waypoints, adaptive, seed, max_cycles
-    ):
+    for output, work_truth, done in detached_cycles(world, waypoints, adaptive, seed, max_cycles):
         outputs.append(output)
         truth.append(work_truth)
+        completed = done
     return DetachedRun(outputs, np.array(truth), completed)
 
 
