@@ -86,10 +86,12 @@ class MavClient:
             to,
         )
 
-    def estimate(self, position_enu: np.ndarray, to: Address | None = None) -> None:
-        """VISION_POSITION_ESTIMATE of an ENU position."""
+    def estimate(
+        self, position_enu: np.ndarray, to: Address | None = None, usec: int = 0
+    ) -> None:
+        """VISION_POSITION_ESTIMATE of an ENU position (stamped ``usec``; 0: unstamped)."""
         n, e, d = (float(v) for v in enu_to_ned(position_enu))
-        self.send(mavlink2.MAVLink_vision_position_estimate_message(0, n, e, d, 0, 0, 0), to)
+        self.send(mavlink2.MAVLink_vision_position_estimate_message(usec, n, e, d, 0, 0, 0), to)
 
     def step_to(self, time_ms: int, timeout_s: float = 5.0) -> list[Any]:
         """Lockstep: tick every vehicle to ``time_ms`` and return what they sent for that step."""

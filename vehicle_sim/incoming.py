@@ -56,11 +56,20 @@ def warn_once(vehicle: Any, text: str) -> None:
 
 
 def on_vision_estimate(vehicle: Any, msg: Any) -> None:
-    """VISION_POSITION_ESTIMATE: the position the autopilot believes from now on."""
+    """VISION_POSITION_ESTIMATE: the position the autopilot believes from now on, unless its
+    sender already gave one stamped as late or later (a datagram delivered twice over a lossy
+    link, or overtaken: taken after the vehicle has moved on, it would set the belief back;
+    an estimate stamped 0 is unstamped and always taken)."""
     values = (msg.x, msg.y, msg.z)
     if not all(math.isfinite(v) and abs(v) < MAX_ABS_COORD_M for v in values):
         vehicle.counters.reject("estimate out of range")
         return
+    sender, stamp = (msg.get_srcSystem(), msg.get_srcComponent()), int(msg.usec)
+    if stamp and stamp <= vehicle.last_estimate_usec.get(sender, 0):
+        vehicle.counters.reject("estimate not newer than the last")
+        return
+    if stamp:
+        vehicle.last_estimate_usec[sender] = stamp
     vehicle.kinematics.set_estimate(ned_to_enu(np.array(values, dtype=float)))
 
 

@@ -64,6 +64,40 @@ def test_work_uav_is_slower_and_a_wrong_estimate_moves_the_truth_wrongly(frame):
     np.testing.assert_allclose(believed, target, atol=1e-4)
 
 
+def test_an_estimate_stamped_no_later_than_the_last_taken_is_ignored(frame):
+    """A datagram delivered twice (or overtaken) would set the belief back after the vehicle
+    moved on: the vehicle takes an estimate only if its sender stamped it later than the last
+    one it took (unstamped ones always)."""
+    home = np.array([0.0, 0.0, 6.0])
+    with vehicle_process("work", home=tuple(home)) as vehicle:
+        client = MavClient(vehicle.address)
+        client.arm_guided(1)
+        a, b, c, d = (home + v for v in ([0.5, 0, 0], [0, 0.7, 0], [0, 0.9, 0], [0, 0, 0.4]))
+        client.estimate(a, usec=2_000_000)
+        client.setpoint(1, a)  # it holds where it believes it is
+        first = _believed(client.step_to(STEP_MS))
+        client.estimate(b, usec=2_000_000)  # the same stamp again
+        client.estimate(c, usec=1_000_000)  # an older one
+        client.setpoint(1, a)
+        held = _believed(client.step_to(2 * STEP_MS))
+        client.estimate(d, usec=3_000_000)
+        client.setpoint(1, d)
+        newer = _believed(client.step_to(3 * STEP_MS))
+        client.estimate(home, usec=0)  # unstamped
+        client.setpoint(1, home)
+        unstamped = _believed(client.step_to(4 * STEP_MS))
+        client.close()
+    np.testing.assert_allclose(first, home + [0.5, 0.0, 0.0], atol=1e-4)
+    np.testing.assert_allclose(held, first, atol=1e-4)
+    np.testing.assert_allclose(newer, home + [0.0, 0.0, 0.4], atol=1e-4)
+    np.testing.assert_allclose(unstamped, home, atol=1e-4)
+
+
+def _believed(messages) -> np.ndarray:
+    local = last(messages, "LOCAL_POSITION_NED")
+    return ned_to_enu(np.array([local.x, local.y, local.z]))
+
+
 def _fixes(messages, frame) -> np.ndarray:
     return np.array(
         [
