@@ -86,9 +86,7 @@ class MavClient:
             to,
         )
 
-    def estimate(
-        self, position_enu: np.ndarray, to: Address | None = None, usec: int = 0
-    ) -> None:
+    def estimate(self, position_enu: np.ndarray, to: Address | None = None, usec: int = 0) -> None:
         """VISION_POSITION_ESTIMATE of an ENU position (stamped ``usec``; 0: unstamped)."""
         n, e, d = (float(v) for v in enu_to_ned(position_enu))
         self.send(mavlink2.MAVLink_vision_position_estimate_message(usec, n, e, d, 0, 0, 0), to)
