@@ -33,6 +33,24 @@ def along_world(along: Scenario) -> World:
     return World(along)
 
 
+@pytest.fixture(scope="session")
+def short_run(tmp_path_factory) -> tuple[Path, Path]:
+    """The short mission run once in lockstep, seed 0: (its folder, its scenario file); tests
+    read it and never change it."""
+    from tests.shared_runs import short_lockstep_run
+
+    return short_lockstep_run(tmp_path_factory.mktemp("short"))
+
+
+@pytest.fixture(scope="session")
+def along_run(tmp_path_factory) -> Path:
+    """``mission run along`` with the defaults, run once (AC, seed 0, lockstep): its folder;
+    tests read it and never change it."""
+    from tests.shared_runs import along_lockstep_run
+
+    return along_lockstep_run(tmp_path_factory.mktemp("along"))
+
+
 @pytest.fixture
 def write_scenario(tmp_path: Path) -> Callable[[str, str], Path]:
     """Write a YAML scenario file into a temporary directory and return its path."""

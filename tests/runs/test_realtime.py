@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from tests.processes import mission
-from tests.runs.test_run import SHORT
 from tests.runs.test_run import _records as _steady_records
+from tests.shared_runs import SHORT
 
 pytestmark = pytest.mark.slow  # every test here starts processes
 
@@ -96,7 +96,7 @@ def _at(track: tuple[list, list], times: list[float]) -> np.ndarray:
 
 
 def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lockstep(
-    tmp_path,
+    tmp_path, along_run
 ):
     from mission.config.scenario import load_scenario
     from mission.world.frames import GeodeticFrame
@@ -130,9 +130,7 @@ def test_a_realtime_run_reports_what_its_truth_shows_and_estimates_as_well_as_lo
     errors = np.linalg.norm(estimates - _at(tracks[1], estimated), axis=1)
     assert summary["work_error_m"]["mean"] == pytest.approx(float(np.mean(errors)), abs=0.001)
 
-    lockstep = tmp_path / "lockstep"
-    assert mission("run", "along", "--out", str(lockstep)).returncode == 0
-    reference = json.loads((lockstep / "summary.json").read_text())
+    reference = json.loads((along_run / "summary.json").read_text())  # lockstep
     assert summary["work_error_m"]["mean"] == pytest.approx(
         reference["work_error_m"]["mean"], rel=0.15
     )

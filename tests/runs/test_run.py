@@ -18,20 +18,10 @@ import numpy as np
 import pytest
 
 from tests.processes import ROOT, vehicle_pids
+from tests.shared_runs import SHORT
 
 pytestmark = pytest.mark.slow  # every test here starts processes
 
-SHORT = """
-extends: along
-name: short-run
-task:
-  work_waypoints_m: [[-6.0, -3.0, 7.0], [-3.0, -3.0, 7.0], [0.0, -3.0, 7.0]]
-  waypoints_dir: plan
-run: {timeout_s: 120.0}
-world:
-  zones:
-    - {name: test, min_m: [-14.0, -12.0, 5.0], max_m: [-4.0, -6.0, 11.0], offset_m: [1.0, 0, 0]}
-"""
 VOLATILE = {"wall_time_s", "realtime_factor", "mpc_solve_ms", "cpu_s"}  # the machine's figures
 LINK_TIMING = {"tick_resends", "late_steps"}  # how often a step was slow: wall-clock too
 
@@ -245,14 +235,15 @@ def test_a_dead_work_vehicle_ends_the_run_with_a_clear_error(scenario, tmp_path)
     assert _children_of(scenario) == []
 
 
-def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_path):
+def test_a_lossy_slow_link_still_completes_and_counts_its_losses(short_run, tmp_path):
+    clean, scenario = short_run  # the same scenario file: the summaries name it
     out = tmp_path / "lossy"
-    result = _run(scenario, out, "--link-loss", "0.2", "--link-delay-ms", "20")
+    result = _run(scenario, out, "--link-loss", "0.2", "--link-delay-ms", "5")
     assert result.returncode == 0, result.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is True
     link = summary["link"]
-    assert (link["loss"], link["delay_ms"]) == (0.2, 20.0)
+    assert (link["loss"], link["delay_ms"]) == (0.2, 5.0)
     # the ground station drops a fifth of what it sends (binomial: +-4 sd over ~450 datagrams:
     # each vehicle's commands and tick leave in one datagram a cycle); lost batches and steps
     # are asked again
@@ -261,14 +252,12 @@ def test_a_lossy_slow_link_still_completes_and_counts_its_losses(scenario, tmp_p
     assert link["tick_resends"] > 0
     assert _children_of(scenario) == []
     # Every lost batch or step was asked again in time, so the run is the lossless run exactly.
-    clean = _run(scenario, tmp_path / "clean")
-    assert clean.returncode == 0, clean.stderr
-    lossless = json.loads((tmp_path / "clean" / "summary.json").read_text())
+    lossless = json.loads((clean / "summary.json").read_text())
     assert link["late_steps"] == 0
     # (a batch sent again after the vehicle stepped on the first carries an estimate it has
     # taken: it ignores it, and its belief goes on as in the lossless run)
     assert _steady(summary) | {"link": None} == _steady(lossless) | {"link": None}
-    assert _records(out) == _records(tmp_path / "clean")
+    assert _records(out) == _records(clean)
 
 
 def _records(out: Path) -> list[dict]:

@@ -131,14 +131,12 @@ def test_a_blind_work_uav_holds_where_it_is(tmp_path):
     assert summary["diagnostics"]["blind_cycles"] == len(records)
 
 
-def test_the_defaults_keep_their_margins_along_the_whole_run(tmp_path):
+def test_the_defaults_keep_their_margins_along_the_whole_run(along_run):
     """Along AC seed 0 with the defaults: no contact, and the truth (read by pymavlink) keeps
     every pair 2 m apart and every UAV 0.5 m from the structure (trimesh) and the ground, at
     every sample."""
-    result = mission("run", "along", "--out", str(tmp_path / "run"))
-    assert result.returncode == 0, result.stderr
-    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    summary = json.loads((along_run / "summary.json").read_text())
     assert summary["completed"] and summary["safety"]["contacts"] == []
-    kept = run_margins(tmp_path / "run", "along")
+    kept = run_margins(along_run, "along")
     assert (kept.separation_m, kept.clearance_m) == (2.0, 0.5)
     assert kept.kept, kept

@@ -1,4 +1,4 @@
-"""A short run and its recording, made once for the viewer's tests."""
+"""The short run's recording, made once for the viewer's tests (the run: ``short_run``)."""
 
 from __future__ import annotations
 
@@ -7,19 +7,7 @@ from pathlib import Path
 import pytest
 
 from tests.processes import mission
-from tests.runs.test_run import SHORT
 from tests.viewer.rrd import read_rrd
-
-
-@pytest.fixture(scope="session")
-def short_run(tmp_path_factory) -> tuple[Path, Path]:
-    """A short lockstep run: (its folder, its scenario file)."""
-    folder = tmp_path_factory.mktemp("view")
-    scenario = folder / "short-run.yaml"
-    scenario.write_text(SHORT)
-    assert mission("plan", str(scenario)).returncode == 0
-    assert mission("run", str(scenario), "--out", str(folder / "run")).returncode == 0
-    return folder / "run", scenario
 
 
 @pytest.fixture(scope="session")
