@@ -137,13 +137,13 @@ def check_recall_in_time(world: KnownWorld) -> None:
     longest flight (around the structure, at its speed limit) from one of its inspection
     waypoints to its planned waypoint where the work UAV's path enters the sky's shadow is
     at most ``roles.recall_clear_s``; else InputError naming that field and the flight."""
-    from mission.link.plan_files import read_vehicle_waypoints
-    from mission.world.routes import route_map
-
     scenario = world.scenario
     roles = scenario.roles
     if roles.policy != "dynamic" or not scenario.task.inspections:
         return
+    from mission.link.plan_files import read_vehicle_waypoints
+    from mission.world.routes import route_map  # scipy: imported only where routes are flown
+
     work = np.asarray(scenario.task.work_waypoints_m, dtype=float)
     sigma = world.gnss.sigma0(work)
     trusted = np.isfinite(sigma) & (sigma <= roles.own_fix_max_sigma_m)

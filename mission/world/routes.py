@@ -17,8 +17,6 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-from scipy.sparse import coo_matrix, diags
-from scipy.sparse.csgraph import dijkstra
 
 from mission.world.grid import VoxelGrid
 from mission.world.model import KnownWorld
@@ -49,6 +47,8 @@ class RouteMap:
         self.graph = self._graph()
 
     def _graph(self):
+        from scipy.sparse import coo_matrix  # scipy, only where routes are flown (~0.3 s)
+
         shape = np.array(self.grid.shape)
         index = np.arange(self.grid.n_voxels).reshape(self.grid.shape)
         rows, cols, weights = [], [], []
@@ -84,6 +84,8 @@ class RouteMap:
         """(sources, targets): the length (m) of the route between each pair, from each
         point to its free voxel's centre, along the least costly voxel way, and on (infinity
         where none joins them)."""
+        from scipy.sparse.csgraph import dijkstra
+
         sources, targets = np.atleast_2d(sources), np.atleast_2d(targets)
         start_cells = [self.cell_of(p) for p in sources]
         end_cells = [self.cell_of(p) for p in targets]
@@ -103,6 +105,8 @@ class RouteMap:
         """Corners from ``start`` to ``goal`` (both included), pulled straight, and kept
         ``radius_m`` from each point of ``avoid`` (other UAVs) where the ends are; None where
         no free way joins them."""
+        from scipy.sparse.csgraph import dijkstra
+
         start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
         avoid = np.zeros((0, 3)) if avoid is None else np.atleast_2d(avoid)
         keep_off = Obstacles(avoid, radius_m)
@@ -135,6 +139,8 @@ class RouteMap:
 
     def _without(self, keep_off: Obstacles, ends: tuple[int, int]):
         """The graph without the voxels ``keep_off`` covers (but the route's ends)."""
+        from scipy.sparse import diags
+
         keep = ~keep_off.covers(self.centres)
         keep[list(ends)] = True
         mask = diags(keep.astype(float))
