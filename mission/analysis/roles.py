@@ -32,13 +32,14 @@ def role_metrics(
     inspections = {i.vehicle: len(i.waypoints_m) for i in scenario.task.inspections}
     seconds: Counter[str] = Counter()
     switches, last = 0, {}
+    supports = trace.supports
     for record in records:
         roles = record.get("roles", {}).get("roles", {})
         for name, role in roles.items():
             seconds[role] += scenario.control.t_cont_s
             switches += role != last.get(name, "formation")
             last[name] = role
-        for name in trace.supports:
+        for name in supports:
             if f"support-{name - 1}" not in roles:
                 seconds["formation"] += scenario.control.t_cont_s
     reached = records[-1].get("roles", {}).get("next_inspection", {}) if records else {}
