@@ -16,6 +16,7 @@ from typing import Any, TextIO
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.bench.floor import bench_floor
 from mission.bench.margins import bench_margins
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
@@ -355,6 +356,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "margins": bench_margins,
     "roles": bench_roles,
     "run": bench_runs,
+    "floor": bench_floor,
     "study": bench_studies,
     "view": bench_view,
 }

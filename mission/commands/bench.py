@@ -13,7 +13,7 @@ def add_parser(commands) -> None:
     parser.add_argument(
         "--only",
         action="append",
-        choices=["world", "vehicle", "gcs", "margins", "roles", "run", "study", "view"],
+        choices=["world", "vehicle", "gcs", "margins", "roles", "run", "floor", "study", "view"],
         help="run only this group (repeatable)",
     )
     parser.set_defaults(handler=bench)

@@ -1,0 +1,38 @@
+"""The floor under a run's CPU seconds: the same Along AC mission decided in one process.
+
+A detached run (:mod:`mission.bench.detached`) makes every decision a run makes - the
+ground station's five steps and the three support MPCs each cycle - against in-process
+kinematic vehicles that sense as the vehicle processes do, with no MAVLink, no sockets and no
+other processes. Its CPU seconds are what the decisions cost on this machine: a run can cost
+less only by deciding differently. ``run_cpu_s`` (all of a run's processes) sits on top of it.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+from mission.bench.result import BenchResult
+
+
+def bench_floor(repeats: int = 3, max_cycles: int = 1000) -> list[BenchResult]:
+    """CPU seconds of a detached Along AC run to completion, and of its support MPCs' plans
+    alone (medians of ``repeats``; references)."""
+    from mission.bench.detached import run_detached
+    from mission.link.plan_files import read_plan
+    from mission.world.model import World
+
+    world = World.load("along")
+    plan = read_plan(world.scenario)
+    waypoints = {"work": plan.work, **{f"support-{n + 1}": p for n, p in enumerate(plan.supports)}}
+    totals, plans = [], []
+    for _ in range(repeats):
+        start = time.process_time()
+        run = run_detached(world, waypoints, adaptive=True, seed=0, max_cycles=max_cycles)
+        totals.append(time.process_time() - start)
+        solves_ms = [p.solve_ms for o in run.outputs for p in o.support_plans.values()]
+        plans.append(sum(solves_ms) / 1000)
+    return [
+        BenchResult("detached_run_cpu_s", statistics.median(totals), "s", "reference", None),
+        BenchResult("detached_plans_s", statistics.median(plans), "s", "reference", None),
+    ]
