@@ -184,14 +184,19 @@ def test_the_roles_row_is_the_median_of_the_paired_runs_ratios(monkeypatch):
 
 def test_the_floor_rows_are_the_detached_runs_cpu_and_plan_seconds(monkeypatch):
     """Three detached runs replaced by ones with known plans, the CPU clock by one that reads
-    2, 5 and 3 s for them: medians 3 s of CPU and the plans' 0.25 s (of 0.1, 0.25, 0.4)."""
+    2, 5 and 3 s for them, the machine at the reference speed (run_cpu_s's target 3.5 s):
+    medians 3 s of CPU, the plans' 0.25 s (of 0.1, 0.25, 0.4), 3 / 3.5 of the target."""
     from mission.bench import detached, floor
+    from mission.procs import machine_speed
 
     runs = iter([_run([50, 50], [1, 1]), _run([100, 150], [1, 1]), _run([400], [1])])
     monkeypatch.setattr(detached, "run_detached", lambda *args, **kwargs: next(runs))
+    monkeypatch.setattr(machine_speed, "python_loop_s", lambda repeats: 0.146)
     clock = iter([0.0, 2.0, 10.0, 15.0, 20.0, 23.0])
     monkeypatch.setattr(floor.time, "process_time", lambda: next(clock))
-    cpu, plans = floor.bench_floor(repeats=3)
+    cpu, plans, over = floor.bench_floor(repeats=3)
     assert (cpu.name, cpu.value, cpu.ok) == ("detached_run_cpu_s", 3.0, None)
     assert (plans.name, plans.ok) == ("detached_plans_s", None)
     assert plans.value == pytest.approx(0.25)
+    assert over.name == "detached_run_cpu_over_run_target" and over.ok is None
+    assert over.value == pytest.approx(3.0 / 3.5)
