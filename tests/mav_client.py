@@ -55,12 +55,17 @@ class MavClient:
         return got
 
     def command(
-        self, command: int, *params: float, to: Address | None = None, system_id: int = 1
+        self,
+        command: int,
+        *params: float,
+        to: Address | None = None,
+        system_id: int = 1,
+        timeout_s: float = 3.0,
     ) -> int | None:
-        """COMMAND_LONG; the COMMAND_ACK result or None."""
+        """COMMAND_LONG; the COMMAND_ACK result or None (none within ``timeout_s``)."""
         values = [*params, *[0.0] * (7 - len(params))]
         self.send(mavlink2.MAVLink_command_long_message(system_id, 1, command, 0, *values), to)
-        ack = self.wait_for("COMMAND_ACK", 3.0, where=lambda m: m.command == command)
+        ack = self.wait_for("COMMAND_ACK", timeout_s, where=lambda m: m.command == command)
         return None if ack is None else int(ack.result)
 
     def arm_guided(self, system_id: int, to: Address | None = None) -> None:

@@ -28,10 +28,10 @@ def key_file(tmp_path):
     return path
 
 
-def _mission_count(client: MavClient) -> object:
+def _mission_count(client: MavClient, timeout_s: float) -> object:
     """Start a mission upload; the vehicle's first MISSION_REQUEST_INT, if any."""
     client.send(mavlink2.MAVLink_mission_count_message(2, 1, 2, 0))
-    return client.wait_for("MISSION_REQUEST_INT", 1.5)
+    return client.wait_for("MISSION_REQUEST_INT", timeout_s)
 
 
 @pytest.mark.slow
@@ -48,9 +48,14 @@ def test_a_signed_vehicle_obeys_only_signed_traffic(key_file, along, client_key,
         # one signed stream (same system, component and link) would have their timestamps
         # interleave, and the vehicle would refuse the older ones as replays
         clock = MavClient(vehicle.address, system_id=254, signing_key=KEY)
-        upload = _mission_count(client)
-        mode = client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 4, system_id=2)
-        arm = client.command(mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 1, system_id=2)
+        # an answer comes within milliseconds; a refused request is given a second to show
+        # that none comes (the obeyed ones return as soon as theirs does)
+        wait_s = 3.0 if obeyed else 1.0
+        upload = _mission_count(client, wait_s)
+        mode = client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 4, system_id=2, timeout_s=wait_s)
+        arm = client.command(
+            mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 1, system_id=2, timeout_s=wait_s
+        )
         client.setpoint(2, HOME + np.array([3.0, 0.0, 0.0]))
         client.send(mavlink2.MAVLink_system_time_message(0, 0))  # a clock tick (a no-op)
         messages = clock.step_to(500)
