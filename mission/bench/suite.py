@@ -16,7 +16,7 @@ from typing import Any, TextIO
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.bench.floor import bench_floor
+from mission.bench.floor import RUN_CPU_TARGET_S, bench_floor
 from mission.bench.margins import bench_margins
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
@@ -28,7 +28,6 @@ from mission.procs.commands import mission_run_argv
 from mission.procs.machine_speed import REFERENCE_LOOP_S, children_cpu_s, python_loop_s
 from mission.procs.stopping import stop_processes
 
-RUN_CPU_TARGET_S = 3.5  # CPU seconds of a whole Along AC run there
 REALTIME_FACTOR_TARGET = 100.0  # Along AC's lockstep real-time factor there
 MULTICOPTER_ALONG = (  # issue 31's: Along AC flown by quadrotors in a 3 m/s gusty wind
     "extends: along\nname: along-multicopter\nvehicle: {dynamics: multicopter}\n"
