@@ -20,6 +20,7 @@ from vehicle_sim.commands import execute, set_mode
 from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
 
 WARNING_REPEAT_S = 5.0
+ESTIMATE_RESTART_S = 2.0  # an estimate stamped further back than this is a sender restarted
 
 
 def on_setpoint(vehicle: Any, msg: Any) -> None:
@@ -57,17 +58,25 @@ def warn_once(vehicle: Any, text: str) -> None:
 
 def on_vision_estimate(vehicle: Any, msg: Any) -> None:
     """VISION_POSITION_ESTIMATE: the position the autopilot believes from now on, unless its
-    sender already gave one stamped as late or later (a datagram delivered twice over a lossy
-    link, or overtaken: taken after the vehicle has moved on, it would set the belief back;
-    an estimate stamped 0 is unstamped and always taken)."""
+    sender already gave one stamped as late or later, by less than ``ESTIMATE_RESTART_S`` (a
+    datagram delivered twice over a lossy link, or overtaken: taken after the vehicle has
+    moved on, it would set the belief back). A stamp further back is a sender that started
+    again (a ground station restarted against running vehicles): taken, and said once. An
+    estimate stamped 0 is unstamped and always taken."""
     values = (msg.x, msg.y, msg.z)
     if not all(math.isfinite(v) and abs(v) < MAX_ABS_COORD_M for v in values):
         vehicle.counters.reject("estimate out of range")
         return
     sender, stamp = (msg.get_srcSystem(), msg.get_srcComponent()), int(msg.usec)
-    if stamp and stamp <= vehicle.last_estimate_usec.get(sender, 0):
-        vehicle.counters.reject("estimate not newer than the last")
-        return
+    last = vehicle.last_estimate_usec.get(sender)
+    if stamp and last is not None and stamp <= last:
+        if last - stamp < ESTIMATE_RESTART_S * 1e6:
+            vehicle.counters.reject("estimate not newer than the last")
+            return
+        back_s = (last - stamp) / 1e6
+        vehicle.notify(
+            mavlink2.MAV_SEVERITY_NOTICE, f"Estimates restarted: stamps {back_s:.1f} s back"
+        )
     if stamp:
         vehicle.last_estimate_usec[sender] = stamp
     vehicle.kinematics.set_estimate(ned_to_enu(np.array(values, dtype=float)))

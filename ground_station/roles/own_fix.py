@@ -42,8 +42,8 @@ class OwnFix:
     reason: str
     sigma_m: float | None = None
     distance_sigmas: float | None = None
-    # the supports' relative estimate's covariance where the verdict reached it (what
-    # combined_estimate weighs the fix against; not recorded)
+    # a used verdict's: the supports' relative estimate's covariance (None where they give
+    # none), what combined_estimate weighs the fix against; not recorded
     relative_cov: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     @property
@@ -107,6 +107,7 @@ def combined_estimate(fix: np.ndarray, verdict: OwnFix, fusion: FusionResult) ->
     information, or the fix alone where the supports give none."""
     covariance = verdict.relative_cov
     if covariance is None:
+        assert fusion.xhat is None, "a verdict from judge() on this fusion carries its covariance"
         return np.asarray(fix, dtype=float).copy()
     assert verdict.sigma_m is not None and fusion.xhat is not None
     own_information = np.linalg.inv(own_covariance(verdict.sigma_m))

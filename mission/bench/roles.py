@@ -31,11 +31,14 @@ def bench_roles(cycles: int = 240, repeats: int = 3) -> list[BenchResult]:
     plan = read_plan(worlds["fixed"].scenario)
     waypoints = {"work": plan.work, **{f"support-{n + 1}": p for n, p in enumerate(plan.supports)}}
     ratios, longest = [], 0.0
-    for _ in range(repeats):
+    for repeat in range(repeats):
         times: dict[str, list[float]] = {"fixed": [], "dynamic": []}
+        order = list(worlds) if repeat % 2 == 0 else list(worlds)[::-1]  # each first in turn
         runs = {
-            policy: detached_cycles(world, waypoints, adaptive=True, seed=0, max_cycles=cycles)
-            for policy, world in worlds.items()
+            policy: detached_cycles(
+                worlds[policy], waypoints, adaptive=True, seed=0, max_cycles=cycles
+            )
+            for policy in order
         }
         while runs:
             for policy in list(runs):

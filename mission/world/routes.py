@@ -44,10 +44,15 @@ class RouteMap:
         # each voxel's cost per metre (1: good GNSS; up to POOR_GNSS_COST): an edge costs its
         # length times the dearer of its two voxels'
         self.cost = np.ones(len(centres)) if cost is None else np.asarray(cost, float).reshape(-1)
+        # scipy only where routes are flown (~0.3 s to import), and all of it here, at
+        # start-up: a route's first search does not pay for it inside a control cycle
+        from scipy.sparse.csgraph import dijkstra
+
+        self._dijkstra = dijkstra
         self.graph = self._graph()
 
     def _graph(self):
-        from scipy.sparse import coo_matrix  # scipy, only where routes are flown (~0.3 s)
+        from scipy.sparse import coo_matrix
 
         shape = np.array(self.grid.shape)
         index = np.arange(self.grid.n_voxels).reshape(self.grid.shape)
@@ -84,12 +89,10 @@ class RouteMap:
         """(sources, targets): the length (m) of the route between each pair, from each
         point to its free voxel's centre, along the least costly voxel way, and on (infinity
         where none joins them)."""
-        from scipy.sparse.csgraph import dijkstra
-
         sources, targets = np.atleast_2d(sources), np.atleast_2d(targets)
         start_cells = [self.cell_of(p) for p in sources]
         end_cells = [self.cell_of(p) for p in targets]
-        _, previous = dijkstra(self.graph, indices=start_cells, return_predecessors=True)
+        _, previous = self._dijkstra(self.graph, indices=start_cells, return_predecessors=True)
         result = np.full((len(sources), len(targets)), np.inf)
         for i, first in enumerate(start_cells):
             for j, last in enumerate(end_cells):
@@ -105,8 +108,6 @@ class RouteMap:
         """Corners from ``start`` to ``goal`` (both included), pulled straight, and kept
         ``radius_m`` from each point of ``avoid`` (other UAVs) where the ends are; None where
         no free way joins them."""
-        from scipy.sparse.csgraph import dijkstra
-
         start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
         avoid = np.zeros((0, 3)) if avoid is None else np.atleast_2d(avoid)
         keep_off = Obstacles(avoid, radius_m)
@@ -114,7 +115,7 @@ class RouteMap:
             return np.vstack([start, goal])
         first, last = self.cell_of(start), self.cell_of(goal)
         graph = self.graph if not len(avoid) else self._without(keep_off, (first, last))
-        _, previous = dijkstra(graph, indices=first, return_predecessors=True)
+        _, previous = self._dijkstra(graph, indices=first, return_predecessors=True)
         cells = _walk_back(previous, first, last)
         if cells is None:
             return None

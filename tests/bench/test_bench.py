@@ -24,7 +24,7 @@ def _run(solves: list[float], cycles: list[float]) -> SimpleNamespace:
         SimpleNamespace(support_plans={"support-1": _Plan(s)}, cycle_ms=c)
         for s, c in zip(solves, cycles)
     ]
-    return SimpleNamespace(outputs=outputs)
+    return SimpleNamespace(outputs=outputs, completed=True)
 
 
 def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
@@ -158,13 +158,14 @@ def test_every_benchmark_group_can_be_chosen_on_the_command_line():
 
 
 def test_the_roles_row_is_the_median_of_the_paired_runs_ratios(monkeypatch):
-    """Detached runs replaced by ones with known cycle times, a pair per repeat: the ratio of
-    each pair's medians (11/10, 12/10, 30/20), their median, and the longest dynamic cycle;
-    the two runs of a pair are stepped in turn."""
+    """Detached runs replaced by ones with known cycle times, a pair per repeat: each pair's
+    medians (fixed 10, 20, 10; dynamic 11, 30, 20), the median of their ratios 1.5 (the ratio
+    of the medians would read 2.0), the longest dynamic cycle; the two runs of a pair are
+    stepped in turn, each pair started by the other policy than the last."""
     from mission.bench import detached, roles
 
-    fixed = iter([[10.0, 10.0, 12.0], [10.0, 9.0, 11.0], [20.0, 20.0, 20.0]])
-    dynamic = iter([[11.0, 11.0, 40.0], [12.0, 12.0, 12.0], [30.0, 30.0, 30.0]])
+    fixed = iter([[10.0, 10.0, 12.0], [20.0, 19.0, 21.0], [10.0, 10.0, 10.0]])
+    dynamic = iter([[11.0, 11.0, 40.0], [30.0, 30.0, 30.0], [20.0, 20.0, 20.0]])
     order = []
 
     def fake(world, waypoints, adaptive, seed, max_cycles):
@@ -176,22 +177,25 @@ def test_the_roles_row_is_the_median_of_the_paired_runs_ratios(monkeypatch):
 
     monkeypatch.setattr(detached, "detached_cycles", fake)
     ratio, longest = roles.bench_roles(cycles=3, repeats=3)
-    assert ratio.name == "dynamic_roles_cycle_ratio" and ratio.value == pytest.approx(1.2)
+    assert ratio.name == "dynamic_roles_cycle_ratio" and ratio.value == pytest.approx(1.5)
     assert ratio.ok is False
     assert longest.value == 40.0 and longest.ok is None
     assert order[:4] == ["fixed", "dynamic", "fixed", "dynamic"]
+    assert order[6:10] == ["dynamic", "fixed", "dynamic", "fixed"]
 
 
 def test_the_floor_rows_are_the_detached_runs_cpu_and_plan_seconds(monkeypatch):
     """Three detached runs replaced by ones with known plans, the CPU clock by one that reads
-    2, 5 and 3 s for them, the machine at the reference speed (run_cpu_s's target 3.5 s):
-    medians 3 s of CPU, the plans' 0.25 s (of 0.1, 0.25, 0.4), 3 / 3.5 of the target."""
+    2, 5 and 3 s for them, the machine's speed read before each (the reference speed, then
+    half and twice as slow: run_cpu_s's target 3.5, 1.75, 7 s): medians 3 s of CPU, the
+    plans' 0.25 s (of 0.1, 0.25, 0.4), and the ratios 2/3.5, 5/1.75, 3/7 -> 2/3.5."""
     from mission.bench import detached, floor
     from mission.procs import machine_speed
 
     runs = iter([_run([50, 50], [1, 1]), _run([100, 150], [1, 1]), _run([400], [1])])
     monkeypatch.setattr(detached, "run_detached", lambda *args, **kwargs: next(runs))
-    monkeypatch.setattr(machine_speed, "python_loop_s", lambda repeats: 0.146)
+    loops = iter([0.146, 0.073, 0.292])
+    monkeypatch.setattr(machine_speed, "python_loop_s", lambda repeats: next(loops))
     clock = iter([0.0, 2.0, 10.0, 15.0, 20.0, 23.0])
     monkeypatch.setattr(floor.time, "process_time", lambda: next(clock))
     cpu, plans, over = floor.bench_floor(repeats=3)
@@ -199,4 +203,16 @@ def test_the_floor_rows_are_the_detached_runs_cpu_and_plan_seconds(monkeypatch):
     assert (plans.name, plans.ok) == ("detached_plans_s", None)
     assert plans.value == pytest.approx(0.25)
     assert over.name == "detached_run_cpu_over_run_target" and over.ok is None
-    assert over.value == pytest.approx(3.0 / 3.5)
+    assert over.value == pytest.approx(2.0 / 3.5)
+
+
+def test_the_floor_refuses_a_detached_run_that_did_not_finish(monkeypatch):
+    from mission.bench import detached, floor
+    from mission.procs import machine_speed
+
+    unfinished = _run([50], [1])
+    unfinished.completed = False
+    monkeypatch.setattr(detached, "run_detached", lambda *args, **kwargs: unfinished)
+    monkeypatch.setattr(machine_speed, "python_loop_s", lambda repeats: 0.146)
+    with pytest.raises(RuntimeError, match="did not finish in 1000 cycles"):
+        floor.bench_floor(repeats=1)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import resource
 import shutil
 import signal
@@ -256,6 +257,11 @@ def test_a_lossy_slow_link_still_completes_and_counts_its_losses(short_run, tmp_
     assert link["late_steps"] == 0
     # (a batch sent again after the vehicle stepped on the first carries an estimate it has
     # taken: it ignores it, and its belief goes on as in the lossless run)
+    refused = [
+        re.search(r"'estimate not newer than the last': (\d+)", (out / f"{name}.log").read_text())
+        for name in ("work", "support-1", "support-2", "support-3")
+    ]
+    assert sum(int(found.group(1)) for found in refused if found) > 0
     assert _steady(summary) | {"link": None} == _steady(lossless) | {"link": None}
     assert _records(out) == _records(clean)
 

@@ -67,30 +67,40 @@ def test_work_uav_is_slower_and_a_wrong_estimate_moves_the_truth_wrongly(frame):
 def test_an_estimate_stamped_no_later_than_the_last_taken_is_ignored(frame):
     """A datagram delivered twice (or overtaken) would set the belief back after the vehicle
     moved on: the vehicle takes an estimate only if its sender stamped it later than the last
-    one it took (unstamped ones always)."""
+    one it took (unstamped ones always); one stamped more than 2 s back is a sender that
+    started again, taken and said."""
     home = np.array([0.0, 0.0, 6.0])
+    first_estimate, repeated, older, newer_estimate = (
+        home + offset for offset in ([0.5, 0, 0], [0, 0.7, 0], [0, 0.9, 0], [0, 0, 0.4])
+    )
+    restarted_estimate = home + [0.0, -0.6, 0.0]
     with vehicle_process("work", home=tuple(home)) as vehicle:
         client = MavClient(vehicle.address)
         client.arm_guided(1)
-        a, b, c, d = (home + v for v in ([0.5, 0, 0], [0, 0.7, 0], [0, 0.9, 0], [0, 0, 0.4]))
-        client.estimate(a, usec=2_000_000)
-        client.setpoint(1, a)  # it holds where it believes it is
+        client.estimate(first_estimate, usec=20_000_000)
+        client.setpoint(1, first_estimate)  # it holds where it believes it is
         first = _believed(client.step_to(STEP_MS))
-        client.estimate(b, usec=2_000_000)  # the same stamp again
-        client.estimate(c, usec=1_000_000)  # an older one
-        client.setpoint(1, a)
+        client.estimate(repeated, usec=20_000_000)  # the same stamp again
+        client.estimate(older, usec=19_000_000)  # an older one
+        client.setpoint(1, first_estimate)
         held = _believed(client.step_to(2 * STEP_MS))
-        client.estimate(d, usec=3_000_000)
-        client.setpoint(1, d)
+        client.estimate(newer_estimate, usec=21_000_000)
+        client.setpoint(1, newer_estimate)
         newer = _believed(client.step_to(3 * STEP_MS))
         client.estimate(home, usec=0)  # unstamped
         client.setpoint(1, home)
         unstamped = _believed(client.step_to(4 * STEP_MS))
+        client.estimate(restarted_estimate, usec=500_000)  # 20.5 s back: a new sender session
+        client.setpoint(1, restarted_estimate)
+        messages = client.step_to(5 * STEP_MS)
         client.close()
-    np.testing.assert_allclose(first, home + [0.5, 0.0, 0.0], atol=1e-4)
+    np.testing.assert_allclose(first, first_estimate, atol=1e-4)
     np.testing.assert_allclose(held, first, atol=1e-4)
-    np.testing.assert_allclose(newer, home + [0.0, 0.0, 0.4], atol=1e-4)
+    np.testing.assert_allclose(newer, newer_estimate, atol=1e-4)
     np.testing.assert_allclose(unstamped, home, atol=1e-4)
+    np.testing.assert_allclose(_believed(messages), restarted_estimate, atol=1e-4)
+    said = [m.text for m in messages if m.get_type() == "STATUSTEXT"]
+    assert "Estimates restarted: stamps 20.5 s back" in said, said
 
 
 def _believed(messages) -> np.ndarray:

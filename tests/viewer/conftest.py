@@ -11,9 +11,11 @@ from tests.viewer.rrd import read_rrd
 
 
 @pytest.fixture(scope="session")
-def replayed(short_run) -> tuple[Path, Path, dict]:
-    """The short run's recording by ``mission view --save``: (run, scenario, rows)."""
+def replayed(short_run, tmp_path_factory) -> tuple[Path, Path, dict]:
+    """The short run's recording by ``mission view --save`` (beside, not in, the shared
+    run's folder): (run, scenario, rows)."""
     run, scenario = short_run
-    result = mission("view", str(run), "--save", str(run.parent / "run.rrd"))
+    recording = tmp_path_factory.mktemp("replay") / "run.rrd"
+    result = mission("view", str(run), "--save", str(recording))
     assert result.returncode == 0, result.stderr
-    return run, scenario, read_rrd(run.parent / "run.rrd")
+    return run, scenario, read_rrd(recording)
