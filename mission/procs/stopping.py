@@ -1,6 +1,8 @@
 """Stopping child processes: SIGTERM to all at once, then SIGKILL to any still there after a
-shared grace period. Works on ``subprocess.Popen`` and on :class:`~mission.procs.forked.
-ForkedProcess` alike (``poll``, ``terminate``, ``wait(timeout)``, ``kill``)."""
+shared grace period; a stopped (frozen: SIGSTOP, a debugger) one is killed at once, since it
+cannot act on SIGTERM until it is continued. Works on ``subprocess.Popen`` and on
+:class:`~mission.procs.forked.ForkedProcess` alike (``pid``, ``poll``, ``terminate``,
+``wait(timeout)``, ``kill``)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,8 @@ from typing import Protocol
 
 class Stoppable(Protocol):
     """What a child must offer to be stopped."""
+
+    pid: int
 
     def poll(self) -> int | None: ...
 
@@ -29,6 +33,8 @@ def stop_processes(processes: Iterable[Stoppable], grace_s: float) -> None:
     for process in processes:
         if process.poll() is None:
             process.terminate()
+            if is_frozen(process.pid):
+                process.kill()
     deadline = time.monotonic() + grace_s
     for process in processes:
         try:
@@ -36,3 +42,14 @@ def stop_processes(processes: Iterable[Stoppable], grace_s: float) -> None:
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
+
+
+def is_frozen(pid: int) -> bool:
+    """Whether the process is stopped (state T or t in ``/proc/<pid>/stat``; False where that
+    cannot be read)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as stat:
+            fields = stat.read().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return False
+    return bool(fields) and fields[0] in ("T", "t")
