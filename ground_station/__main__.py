@@ -1,11 +1,17 @@
-"""Entry point for ``python -m ground_station``."""
+"""Entry point for ``python -m ground_station`` and the ``mission-ground-station`` command."""
 
 import sys
 
-from mission.procs.math_threads import use_one_math_thread
+from mission.procs.numerics import prepare_numerics
 
-use_one_math_thread()
 
-from ground_station.cli import entry_point  # noqa: E402  (numpy loads here, after the setting)
+def main() -> int:
+    """Set up the numerics, then run the command line."""
+    prepare_numerics()  # before anything imports numpy
+    from ground_station.cli import entry_point  # numpy loads here, after the set-up
 
-sys.exit(entry_point())
+    return entry_point()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,11 +1,18 @@
-"""Entry point for ``python -m mission``."""
+"""Entry point for ``python -m mission`` and the ``mission`` command."""
 
 import sys
 
-from mission.procs.math_threads import use_one_math_thread
+from mission.procs.numerics import prepare_numerics
 
-use_one_math_thread()  # numpy loads with one BLAS thread: `mission run` forks its vehicles
 
-from mission.cli import entry_point  # noqa: E402
+def main() -> int:
+    """Set up the numerics, then run the command line."""
+    prepare_numerics()  # before anything imports numpy
+    # numpy loads with the set-up; `mission run` forks its vehicles, which keep it
+    from mission.cli import entry_point
 
-sys.exit(entry_point())
+    return entry_point()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

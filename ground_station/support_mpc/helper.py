@@ -100,7 +100,7 @@ def _serve_quietly(requests: BinaryIO, answers: BinaryIO) -> int:
 
 
 if __name__ == "__main__":
-    from mission.procs.math_threads import use_one_math_thread
+    from mission.procs.numerics import prepare_numerics
 
-    use_one_math_thread()  # before serve() imports numpy
+    prepare_numerics()  # before serve() imports numpy
     sys.exit(main())
