@@ -29,6 +29,7 @@ from mission.procs.cli_common import (
     run_guarded,
 )
 from mission.procs.outputs import check_output_dir, check_output_file
+from mission.procs.provenance import run_provenance
 from mission.world.model import KnownWorld
 
 G_SNAPSHOT_CHOICES = ("every", "ends", "none")  # ground_station.records.G_SNAPSHOTS (tested)
@@ -160,6 +161,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     who = {"scenario": scenario.name, "scenario_source": scenario.source}
     summary = {**who, "method": args.method, "seed": args.seed, **summary}
     summary["link"] = json.loads((out / "link.json").read_text())
+    summary["provenance"] = run_provenance()
     write_text_atomically(out / "summary.json", json.dumps(summary, indent=2) + "\n")
     print(json.dumps(summary))
     return 0

@@ -1,12 +1,13 @@
 """Every metric of a run's summary.json that its files determine: the tlog's (Table 3's), the
-mode and the ages of the measurements the ground station used, the support MPCs' solve times
-and the diagnostics, which also read ``records.jsonl``."""
+mode and the ages of the measurements the ground station used, the support MPCs' solve times,
+the diagnostics and the digest of the decisions, which also read ``records.jsonl``."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
+from mission.analysis.decisions import decisions_digest
 from mission.analysis.diagnostics import diagnostics, read_records
 from mission.analysis.metrics import (
     RunTrace,
@@ -37,4 +38,5 @@ def metrics_of(trace: RunTrace, world: World, run_dir: Path, scenario: Scenario)
         metrics["mpc_solve_ms"] = mpc_stats(records)
         metrics["diagnostics"] = diagnostics(trace, records, world, scenario)
         metrics["roles"] = role_metrics(trace, records, world, scenario)
+        metrics["decisions_digest"] = decisions_digest(records)
     return metrics

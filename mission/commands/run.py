@@ -17,6 +17,7 @@ from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import check_seed
 from mission.procs.outputs import check_output_dir
+from mission.runs.lockstep_check import integrity_note
 from mission.runs.stall import DEFAULT_STALL_S
 
 
@@ -197,5 +198,5 @@ def run_line(summary: dict, timeout_s: float) -> str:
     return (
         f"{done}; {summary['control_cycles']} cycles; steps in multipath "
         f"{summary['multipath_steps_total']} ({per_support}); work UAV error {error}; "
-        f"wall {summary['wall_time_s']:.1f} s{speed}{closest}{clear}"
+        f"wall {summary['wall_time_s']:.1f} s{speed}{closest}{clear}{integrity_note(summary)}"
     )

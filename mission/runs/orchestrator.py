@@ -32,7 +32,9 @@ from mission.procs.cli_common import child_environment
 from mission.procs.file_tail import FileTail
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
+from mission.procs.provenance import run_provenance
 from mission.procs.stopping import stop_processes
+from mission.runs.lockstep_check import lockstep_integrity
 from mission.runs.stall import DEFAULT_STALL_S, StallWatch
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
@@ -119,6 +121,9 @@ def run_mission(
     if watcher is not None:
         watcher.finish()
     summary = _summary(options, scenario, time.monotonic() - start)
+    if options.speedup is None:
+        vehicles = {c.name: c.log for c in children if c.name != "ground_station"}
+        summary["lockstep"] = lockstep_integrity(vehicles, summary.get("link"))
     summary["cpu_s"] = _cpu_seconds(children)
     write_text_atomically(options.out_dir / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
@@ -216,6 +221,7 @@ def _summary(options: RunOptions, scenario: Scenario, wall: float) -> dict[str, 
         "seed": options.seed,
         "speedup": options.speedup,  # None: lockstep
         **run_metrics(options.out_dir / "gcs.tlog", scenario),
+        "provenance": run_provenance(),
     }
     simulated = (summary["control_cycles"] or 0) * scenario.control.t_cont_s
     summary["wall_time_s"] = round(wall, 3)

@@ -20,6 +20,7 @@ _LEADING = ["scenario", "point", "method", "seed"]
 _TRAILING = ["wall_time_s", "node", "run_key"]
 _SKIPPED = {"scenario", "method", "seed", "scenario_source", "study", "link_events", "link"}
 _SKIPPED |= {"cpu_s"}  # the machine's, like the wall time, and not a metric of the run
+_SKIPPED |= {"provenance"}  # the code's and the machine's: the study's provenance.json
 
 
 def result_row(spec: StudySpec, run: StudyRun, summary: dict[str, Any]) -> dict:

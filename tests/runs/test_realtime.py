@@ -4,7 +4,6 @@ and lockstep's records are exactly what they were before measurements carried th
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 from pathlib import Path
@@ -12,17 +11,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mission.analysis.decisions import decisions_digest
+from mission.analysis.diagnostics import read_records
 from tests.processes import mission
-from tests.runs.test_run import _records as _steady_records
 from tests.shared_runs import SHORT
 
 pytestmark = pytest.mark.slow  # every test here starts processes
 
-# sha256 of the short run's records (seed 0, lockstep, the paper's form) without their
-# wall-clock figures, as the ground station wrote them before measurements carried time
-# stamps (re-taken on numpy 2.4 and casadi 3.8.2, where the code before the safety margins gives
-# the same). A change that means to alter lockstep results says so by updating it.
-LOCKSTEP_RECORDS_SHA256 = "5a1c68f7c291e624"
+# The digest of the short run's decisions (seed 0, lockstep, the paper's form:
+# mission.analysis.decisions), as the ground station made them before measurements carried
+# time stamps. A change that means to alter lockstep results says so by updating it.
+LOCKSTEP_DECISIONS = "469a10ad51a85533"
 
 
 def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
@@ -36,14 +35,13 @@ def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
     assert mission("plan", str(scenario)).returncode == 0
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
-    records = _steady_records(tmp_path / "run")
+    records = read_records(tmp_path / "run" / "records.jsonl")
     assert all("age_ms" not in record for record in records)
-    text = json.dumps(records, sort_keys=True).encode()
-    digest = hashlib.sha256(text).hexdigest()[:16]
-    assert digest == LOCKSTEP_RECORDS_SHA256, (
-        f"the lockstep records changed ({len(records)} cycles, the first xhat "
+    digest = decisions_digest(records)
+    assert digest == LOCKSTEP_DECISIONS, (
+        f"the lockstep decisions changed ({len(records)} cycles, the first xhat "
         f"{records[0]['xhat']}, the last at t = {records[-1]['t']}): a change in what the "
-        f"paper's form decides; if it is meant, LOCKSTEP_RECORDS_SHA256 = {digest!r}"
+        f"paper's form decides; if it is meant, LOCKSTEP_DECISIONS = {digest!r}"
     )
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["mode"] == "lockstep" and summary["speedup"] is None

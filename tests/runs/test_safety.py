@@ -5,7 +5,6 @@ holds."""
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import json
 from pathlib import Path
@@ -14,11 +13,12 @@ import numpy as np
 import pytest
 import trimesh
 
+from mission.analysis.decisions import decisions_digest
+from mission.analysis.diagnostics import read_records
 from mission.config.scenario import load_scenario
 from mission.world.model import World
 from tests.margins_check import independent_truth, run_margins
 from tests.processes import mission
-from tests.runs.test_run import _records
 
 pytestmark = pytest.mark.slow  # every test here starts processes
 
@@ -28,10 +28,11 @@ name: paper-form
 control: {{min_separation_m: 0, clearance_m: 0}}
 run: {{stop_on_crash: {stop}}}
 """
-# Along AC seed 0 in the paper's form, records without wall-clock figures and the MPCs' paths
-# (tests.runs.test_run._records), as the ground station wrote them before the safety margins:
-# 509 cycles. A change that means to alter the paper's form says so by updating it.
-PAPER_FORM_RECORDS = (509, "7ce94cd2d0a9c0c1")
+# Along AC seed 0 in the paper's form: its cycles and the digest of its decisions
+# (mission.analysis.decisions: every record but its wall-clock fields, numbers to 1e-6), the
+# same whatever SIMD numpy and OpenBLAS use. A change that means to alter the paper's form
+# says so by updating it.
+PAPER_FORM_DECISIONS = (509, "d20f4eb6c1d54842")
 
 
 def _paper_form(tmp_path: Path, stop: bool) -> Path:
@@ -43,10 +44,11 @@ def _paper_form(tmp_path: Path, stop: bool) -> Path:
 def test_the_papers_form_is_one_setting_away(tmp_path):
     result = mission("run", str(_paper_form(tmp_path, False)), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
-    records = _records(tmp_path / "run")
-    digest = hashlib.sha256(json.dumps(records, sort_keys=True).encode()).hexdigest()[:16]
-    assert (len(records), digest) == PAPER_FORM_RECORDS
-    safety = json.loads((tmp_path / "run" / "summary.json").read_text())["safety"]
+    records = read_records(tmp_path / "run" / "records.jsonl")
+    assert (len(records), decisions_digest(records)) == PAPER_FORM_DECISIONS
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["decisions_digest"] == PAPER_FORM_DECISIONS[1]
+    safety = summary["safety"]
     # without margins support-1 flies into the deck's edge and on: recorded, not stopped
     assert safety["contacts"] and not any(c["crash"] for c in safety["contacts"])
     assert "support-1" in safety["touching_vehicles"]
