@@ -7,8 +7,10 @@ report (no wall times, no dates).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from mission.procs.atomic import write_text_atomically
+from mission.studies.provenance_file import historical_line, report_footer
 from mission.studies.report_figures import write_figures
 from mission.studies.results import metric_values, paired
 from mission.studies.spec import StudySpec
@@ -38,15 +40,23 @@ ROLE_METRICS = (
 PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
 
 
-def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) -> None:
+def write_report(
+    out_dir: Path,
+    spec: StudySpec,
+    rows: list[dict],
+    failed: int,
+    provenance: dict[str, Any] | None = None,
+) -> None:
     """report.md and its figures (in ``figures/``); a metric no run has (a study made before
     the metric existed) is left out of both, and so are the roles' where no support
-    inspected."""
+    inspected. With ``provenance``, its footer says where the numbers came from, and a
+    historical study says so in the first line."""
     inspected = any(float(r.get("roles.support_minutes.inspecting") or 0) > 0 for r in rows)
     shown = METRICS + (ROLE_METRICS if inspected else ())
     metrics = tuple(m for m in shown if any(r.get(m[0]) is not None for r in rows))
     figures = write_figures(out_dir / "figures", spec, rows, metrics)
-    lines = [f"# Study: {spec.name}", ""]
+    first = historical_line(provenance)
+    lines = ([first, ""] if first else []) + [f"# Study: {spec.name}", ""]
     if spec.description:
         lines += [spec.description, ""]
     lines += [
@@ -67,6 +77,7 @@ def write_report(out_dir: Path, spec: StudySpec, rows: list[dict], failed: int) 
     if figures:
         lines += ["", "## Figures", ""]
         lines += [f"![{path.stem}](figures/{path.name})" for path in figures]
+    lines += report_footer(provenance)
     write_text_atomically(out_dir / "report.md", "\n".join(lines) + "\n")
 
 

@@ -74,23 +74,27 @@ def study_runs(spec: StudySpec, names: dict[str, str], code: str) -> list[StudyR
             resolved = resolved_key(scenario, point)
             for seed in spec.seeds:
                 for method in spec.methods:
-                    identity = {"scenario": resolved, "method": method, "seed": seed, "code": code}
-                    if spec.speedup is not None:  # a lockstep run's key names no clock
-                        identity["realtime"] = spec.speedup
-                    key = _digest(identity)
-                    runs.append(
-                        StudyRun(
-                            scenario,
-                            names[scenario],
-                            number,
-                            point.as_dict(),
-                            method,
-                            seed,
-                            key,
-                            spec.speedup,
-                        )
-                    )
+                    where = (scenario, names[scenario], number, point)
+                    runs.append(keyed_run(where, resolved, method, seed, code, spec.speedup))
     return runs
+
+
+def keyed_run(
+    where: tuple[str, str, int, Point],
+    resolved: str,
+    method: str,
+    seed: int,
+    code: str,
+    speedup: float | None = None,
+) -> StudyRun:
+    """A run of ``where`` (scenario reference, its name, point number, point), whose
+    resolved scenario has the digest ``resolved``, keyed by all that determines it."""
+    scenario, name, number, point = where
+    identity = {"scenario": resolved, "method": method, "seed": seed, "code": code}
+    if speedup is not None:  # a lockstep run's key names no clock
+        identity["realtime"] = speedup
+    key = _digest(identity)
+    return StudyRun(scenario, name, number, point.as_dict(), method, seed, key, speedup)
 
 
 def resolved_key(scenario: str, point: Point) -> str:

@@ -16,8 +16,10 @@ from typing import Any, Protocol, TextIO
 
 from mission.procs.atomic import write_text_atomically
 from mission.procs.machine_speed import REFERENCE_LOOP_S, python_loop_s
+from mission.studies.canary import canary_record, canary_runs
 from mission.studies.execute import Keep, finished_summary
 from mission.studies.local_engine import Done
+from mission.studies.provenance_file import read_provenance, study_provenance, write_provenance
 from mission.studies.report import write_report
 from mission.studies.results import read_results_csv, result_row, results_csv
 from mission.studies.runkeys import StudyRun, code_version, study_runs
@@ -52,11 +54,11 @@ class StudyOutcome:
     wall_time_s: float
 
 
-def plan_runs(spec: StudySpec) -> list[StudyRun]:
+def plan_runs(spec: StudySpec, code: str | None = None) -> list[StudyRun]:
     """Every run of the study, keyed (validates every point first)."""
     resolved = validate_points(spec)
     names = {scenario: resolved[(scenario, 0)].name for scenario in spec.scenarios}
-    return study_runs(spec, names, code_version())
+    return study_runs(spec, names, code or code_version())
 
 
 def run_study(
@@ -66,78 +68,112 @@ def run_study(
     keep: Keep = "all",
     progress: TextIO = sys.stderr,
     runs_dir: Path | None = None,
+    canary: bool = False,
 ) -> StudyOutcome:
-    """Run what is not finished yet and write results.csv and report.md. ``runs_dir``
-    (default ``OUT/runs``) may be shared between studies: a run's folder is named by its key,
-    so a run that two studies hold in common is made once."""
-    runs = plan_runs(spec)
+    """Run what is not finished yet and write results.csv, provenance.json and report.md.
+    ``runs_dir`` (default ``OUT/runs``) may be shared between studies: a run's folder is
+    named by its key, so a run that two studies hold in common is made once. With ``canary``,
+    the canary's runs go first (:mod:`mission.studies.canary`)."""
+    code = code_version()
+    runs = plan_runs(spec, code)
+    canaries = canary_runs(code) if canary else []
     runs_dir = runs_dir or out_dir / "runs"
     out_dir.mkdir(parents=True, exist_ok=True)
     runs_dir.mkdir(parents=True, exist_ok=True)
-    summaries: dict[StudyRun, dict[str, Any]] = {}
-    for run in runs:
-        summary = finished_summary(run, runs_dir / run.folder)
-        if summary is not None:
-            summaries[run] = summary
-    pending = [run for run in runs if run not in summaries]
+    summaries = finished_summaries(canaries + runs, runs_dir)
+    pending = [run for run in canaries + runs if run not in summaries]
     failed: list[str] = []
-    bar = ProgressBar(len(runs), len(summaries), progress, engine.description)
+    already = sum(1 for run in runs if run in summaries)
+    bar = ProgressBar(len(runs), already, progress, engine.description)
     note = duration_note(len(pending), engine.cores)
     if note:
         progress.write(note + "\n")
     start = last_report = time.monotonic()
+    outputs = StudyOutputs(out_dir, spec, runs, canaries, code)
 
     def done(run: StudyRun, summary: dict | None, wall: float) -> None:
         nonlocal last_report
+        if summary is not None:
+            summaries[run] = summary
+        if run in canaries:
+            progress.write(canary_line(run, summary) + "\n")
+            return
         point = spec.points[run.point].label
         name = run.folder if len(spec.points) == 1 else f"{run.folder} [{point}]"
         if summary is None:
             failed.append(run.folder)
             bar.advance(f"{name}: FAILED (see {runs_dir / run.folder})")
         else:
-            summaries[run] = summary
             bar.advance(f"{name}: {_one_line(summary)}")
         report = time.monotonic() - last_report > REPORT_EVERY_S
-        write_outputs(out_dir, spec, runs, summaries, len(failed), report)
+        outputs.write(summaries, len(failed), report)
         last_report = time.monotonic() if report else last_report
 
     try:
         if pending:
             engine.run(pending, runs_dir, keep, done)
     finally:
-        write_outputs(out_dir, spec, runs, summaries, len(failed), report=True)
+        outputs.write(summaries, len(failed), report=True)
     return StudyOutcome(
-        len(summaries) - (len(runs) - len(pending)),
-        len(runs) - len(pending),
+        sum(1 for run in runs if run in summaries) - already,
+        already,
         failed,
         round(time.monotonic() - start, 1),
     )
 
 
-def write_outputs(
-    out_dir: Path,
-    spec: StudySpec,
-    runs: list[StudyRun],
-    summaries: dict[StudyRun, dict[str, Any]],
-    failed: int,
-    report: bool,
-) -> None:
-    """results.csv from the summaries; with ``report``, report.md and its figures too (and
-    Table 3 if the study asks)."""
-    rows = [result_row(spec, run, summaries[run]) for run in runs if run in summaries]
-    write_text_atomically(out_dir / "results.csv", results_csv(spec, rows))
-    if report:
-        write_report(out_dir, spec, rows, failed)
-        if "table3" in spec.tables:
-            write_tables(out_dir, rows)
+def finished_summaries(runs: list[StudyRun], runs_dir: Path) -> dict[StudyRun, dict[str, Any]]:
+    """The summaries of the runs already finished (by their keys) in ``runs_dir``."""
+    summaries = {}
+    for run in runs:
+        summary = finished_summary(run, runs_dir / run.folder)
+        if summary is not None:
+            summaries[run] = summary
+    return summaries
+
+
+def canary_line(run: StudyRun, summary: dict | None) -> str:
+    """The progress line of a finished canary run."""
+    if summary is None:
+        return f"canary {run.folder}: FAILED"
+    return f"canary {run.folder}: decisions {summary.get('decisions_digest')}"
+
+
+@dataclass
+class StudyOutputs:
+    """What a study writes from its finished summaries: results.csv and provenance.json,
+    and report.md with its figures (and Table 3 if the study asks)."""
+
+    out_dir: Path
+    spec: StudySpec
+    runs: list[StudyRun]
+    canaries: list[StudyRun]
+    code: str
+
+    def write(self, summaries: dict[StudyRun, dict[str, Any]], failed: int, report: bool) -> None:
+        """results.csv and provenance.json; with ``report``, report.md too."""
+        spec = self.spec
+        rows = [result_row(spec, run, summaries[run]) for run in self.runs if run in summaries]
+        write_text_atomically(self.out_dir / "results.csv", results_csv(spec, rows))
+        provenance = None
+        if self.canaries:
+            made = [summaries.get(run) for run in self.canaries]
+            numerics = ((made[0] or {}).get("provenance") or {}).get("numerics")
+            canary = canary_record(made)
+            provenance = study_provenance(spec.name, self.code, canary, numerics)
+            write_provenance(self.out_dir, provenance)
+        if report:
+            write_report(self.out_dir, spec, rows, failed, provenance)
+            if "table3" in spec.tables:
+                write_tables(self.out_dir, rows)
 
 
 def rewrite_report(spec: StudySpec, out_dir: Path) -> int:
     """report.md, its figures (and Table 3 if the study asks) written again from
-    ``out_dir``'s results.csv, running nothing: a report of the code of the day from rows of
-    an earlier run of the study. The number of rows."""
+    ``out_dir``'s results.csv and provenance.json, running nothing: a report of the code of the
+    day from rows of an earlier run of the study. The number of rows."""
     rows = read_results_csv((out_dir / "results.csv").read_text(encoding="utf-8"))
-    write_report(out_dir, spec, rows, failed=0)
+    write_report(out_dir, spec, rows, failed=0, provenance=read_provenance(out_dir))
     if "table3" in spec.tables:
         write_tables(out_dir, rows)
     return len(rows)

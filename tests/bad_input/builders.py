@@ -58,6 +58,17 @@ def study_file(tmp: Path, body: str = "") -> Path:
     return path
 
 
+def results(tmp: Path, *rows: str) -> Path:
+    """A committed study's folder (``committed``) whose results.csv holds Along AC seed 0
+    (the run of :func:`study_file`'s study) and ``rows``."""
+    folder = tmp / "committed"
+    folder.mkdir(exist_ok=True)
+    lines = ["scenario,point,method,seed,control_cycles", "along,0,ac,0,500"]
+    lines += [f"{row},500" for row in rows]
+    (folder / "results.csv").write_text("\n".join(lines) + "\n")
+    return folder
+
+
 def raw_file(tmp: Path, text: str) -> Path:
     path = tmp / "raw.yaml"
     path.write_text(text)

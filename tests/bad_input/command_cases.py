@@ -11,6 +11,7 @@ from tests.bad_input.builders import (
     new_dir,
     plain_file,
     raw_file,
+    results,
     study_file,
     tlog_run,
 )
@@ -190,6 +191,67 @@ COMMAND_CASES = [
         "study-runs-under-file",
         lambda t: ["study", str(study_file(t)), "--runs", str(plain_file(t) / "r")],
         ["--runs", "under"],
+    ),
+    # --- mission study --verify --------------------------------------------------------
+    (
+        "study-verify-zero",
+        lambda t: ["study", str(study_file(t)), "--verify", "0", "--against", str(results(t))],
+        ["--verify", ">= 1"],
+    ),
+    ("study-verify-alone", lambda t: ["study", str(study_file(t)), "--verify", "2"], ["--against"]),
+    (
+        "study-against-alone",
+        lambda t: ["study", str(study_file(t)), "--against", str(results(t))],
+        ["--against", "is for --verify"],
+    ),
+    (
+        "study-historical-alone",
+        lambda t: ["study", str(study_file(t)), "--historical", "old code"],
+        ["--historical", "--report-only"],
+    ),
+    (
+        "study-against-empty",
+        lambda t: ["study", str(study_file(t)), "--verify", "1", "--against", str(new_dir(t, "c"))],
+        ["--against", "no results.csv"],
+    ),
+    (
+        "study-against-foreign-row",
+        lambda t: [
+            "study",
+            str(study_file(t)),
+            "--verify",
+            "all",
+            "--against",
+            str(results(t, "wall,0,ac,0")),
+        ],
+        ["results.csv", "line 3", "wall point 0 ac seed 0 is not a run"],
+    ),
+    (
+        "study-verify-into-against",
+        lambda t: [
+            "study",
+            str(study_file(t)),
+            "--verify",
+            "1",
+            "--against",
+            str(results(t)),
+            "--out",
+            str(t / "committed"),
+        ],
+        ["--out", "must not be --against"],
+    ),
+    (
+        "study-historical-blank",
+        lambda t: [
+            "study",
+            str(study_file(t)),
+            "--report-only",
+            "--out",
+            str(results(t)),
+            "--historical",
+            " ",
+        ],
+        ["--historical", "say why"],
     ),
     # --- signing keys ------------------------------------------------------------------
     ("key-missing", lambda t: [*RUN, "--signing-key", str(t / "none.key")], ["none.key"]),

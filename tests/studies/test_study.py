@@ -36,6 +36,7 @@ def _summary(run: StudyRun) -> dict:
             "time_beyond_flight_s": time_s - 230.0,
         },
         "wall_time_s": 5.0,
+        "decisions_digest": f"{run.scenario_name}-{run.point}-{run.method}-{run.seed}",
     }
 
 

@@ -1,0 +1,84 @@
+"""The canary: two short fixed runs a study makes at its start, whose decisions' digests
+(:mod:`mission.analysis.decisions`) stand for what the code and machine decide.
+
+A committed study's ``provenance.json`` keeps the canary its code gave. Today's code giving
+another canary means the study's numbers may no longer be what the code gives: ``mission
+study --verify`` says so first, and the suite fails until the study is made again or marked
+historical (docs/development.md). Between them the two runs exercise the defaults' whole
+cycle (GNSS from the sky and the zones, the fusion, G, the MPCs with their margins) with
+kinematic points in Along, and a flying quadrotor in gusty wind with dynamic roles, routes and
+the work UAV's own fix in piers: 40 simulated seconds each, about 3 and 6 s of wall time.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from typing import Any
+
+from mission.studies.runkeys import StudyRun, keyed_run, resolved_key
+from mission.studies.spec import Point
+
+CANARY_S = 40.0  # simulated seconds of each canary run
+
+
+@dataclass(frozen=True)
+class CanaryRun:
+    """One run of the canary."""
+
+    scenario: str  # an embedded scenario
+    overrides: tuple[tuple[str, Any], ...]
+    method: str
+    seed: int
+
+    @property
+    def label(self) -> str:
+        """``along AC seed 0 (run.timeout_s=40.0)``."""
+        point = Point(self.overrides).label
+        return f"{self.scenario} {self.method.upper()} seed {self.seed} ({point})"
+
+
+CANARY = (
+    CanaryRun("along", (("run.timeout_s", CANARY_S),), "ac", 0),
+    CanaryRun(
+        "piers",
+        (
+            ("run.timeout_s", CANARY_S),
+            ("roles.policy", "dynamic"),
+            ("vehicle.dynamics", "multicopter"),
+            ("world.wind.speed_m_s", 3.0),
+        ),
+        "ac",
+        0,
+    ),
+)
+
+
+def canary_runs(code: str) -> list[StudyRun]:
+    """The canary's runs, keyed as a study's runs are (named ``canary-<scenario>``, so a
+    shared runs folder holds them once per code version)."""
+    runs = []
+    for number, canary in enumerate(CANARY):
+        point = Point(canary.overrides)
+        where = (canary.scenario, f"canary-{canary.scenario}", number, point)
+        resolved = resolved_key(canary.scenario, point)
+        runs.append(keyed_run(where, resolved, canary.method, canary.seed, code))
+    return runs
+
+
+def canary_record(summaries: list[dict[str, Any] | None]) -> dict[str, Any]:
+    """What provenance.json keeps of the canary: each run's label and digest, and one digest
+    of them all (None where a run failed or gave none)."""
+    digests = [(summary or {}).get("decisions_digest") for summary in summaries]
+    combined = None
+    if digests and all(digests):
+        text = json.dumps(digests).encode()
+        combined = hashlib.sha256(text).hexdigest()[:16]
+    return {
+        "digest": combined,
+        "runs": [
+            {"run": canary.label, "decisions_digest": digest}
+            for canary, digest in zip(CANARY, digests)
+        ],
+    }

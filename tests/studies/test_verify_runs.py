@@ -1,0 +1,69 @@
+"""Every number we publish reproduces: today's canary against each committed study's, and
+two rows of Table 3 (our defaults and the paper's form) made again and compared."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mission.studies.canary import canary_record, canary_runs
+from mission.studies.local_engine import LocalEngine
+from mission.studies.provenance_file import read_provenance
+from mission.studies.runkeys import code_version
+from tests.processes import ROOT, mission
+
+pytestmark = pytest.mark.slow  # every test here starts runs
+
+COMMITTED = ROOT / "docs" / "studies"
+
+
+@pytest.fixture(scope="module")
+def canary(tmp_path_factory) -> tuple[Path, dict]:
+    """Today's canary, made once: (the runs folder holding it, its record)."""
+    runs_dir = tmp_path_factory.mktemp("runs")
+    runs = canary_runs(code_version())
+    made: dict = {}
+    LocalEngine(2).run(runs, runs_dir, "logs", lambda run, summary, _: made.update({run: summary}))
+    return runs_dir, canary_record([made.get(run) for run in runs])
+
+
+@pytest.mark.determinism
+def test_every_committed_study_gives_todays_canary_or_is_marked_historical(canary):
+    """A commit that changes what the code decides leaves the committed studies stale: it
+    re-runs them, or marks them historical (docs/development.md)."""
+    _, today = canary
+    assert today["digest"], today
+    stale = []
+    for folder in sorted(p for p in COMMITTED.iterdir() if p.is_dir()):
+        provenance = read_provenance(folder)
+        if provenance is None or provenance.get("historical"):
+            continue  # test_provenance_files: each has one (and historical ones say why)
+        theirs = (provenance.get("canary") or {}).get("digest")
+        if theirs != today["digest"]:
+            commit = str(provenance.get("commit"))[:12]
+            stale.append(f"{folder.name} (made with {commit}, canary {theirs})")
+    assert not stale, (
+        f"today's canary is {today['digest']} ({today['runs']}); these studies were made "
+        f"with other decisions: re-run them or mark them historical: {', '.join(stale)}"
+    )
+
+
+@pytest.mark.parametrize("study", ["table3", "table3-paper"])
+def test_two_rows_of_table3_are_made_again_as_committed(study, canary, tmp_path):
+    runs_dir, _ = canary  # the canary is made once for both
+    result = mission(
+        "study",
+        f"studies/{study}.yaml",
+        "--verify",
+        "2",
+        "--against",
+        str(COMMITTED / study),
+        "--out",
+        str(tmp_path / "verify"),
+        "--runs",
+        str(runs_dir),
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "2 of 2 rows compared: 0 differ" in result.stdout
+    assert "as when the study was made" in result.stdout
