@@ -81,12 +81,14 @@ class MavClient:
         to: Address | None = None,
         type_mask: int = POSITION_ONLY,
         frame: int = mavlink2.MAV_FRAME_LOCAL_NED,
+        time_boot_ms: int = 0,
     ) -> None:
-        """SET_POSITION_TARGET_LOCAL_NED toward an ENU point."""
+        """SET_POSITION_TARGET_LOCAL_NED toward an ENU point (stamped ``time_boot_ms``; 0:
+        unstamped)."""
         n, e, d = (float(v) for v in enu_to_ned(target_enu))
         self.send(
             mavlink2.MAVLink_set_position_target_local_ned_message(
-                0, system_id, 1, frame, type_mask, n, e, d, 0, 0, 0, 0, 0, 0, 0, 0
+                time_boot_ms, system_id, 1, frame, type_mask, n, e, d, 0, 0, 0, 0, 0, 0, 0, 0
             ),
             to,
         )

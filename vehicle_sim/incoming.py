@@ -25,9 +25,15 @@ ESTIMATE_RESTART_S = 2.0  # an estimate stamped further back than this is a send
 
 def on_setpoint(vehicle: Any, msg: Any) -> None:
     """SET_POSITION_TARGET_LOCAL_NED: a new target, unless it is refused (then, if the fence
-    refused it, the vehicle stops where it is)."""
+    refused it, the vehicle stops where it is). The same setpoint again with the same stamp
+    (a datagram sent again, or delivered twice) is ignored: taken after the vehicle has
+    stepped, its fence check would start from a later belief. An unstamped one is always
+    taken."""
     if vehicle.crashed:
         vehicle.counters.reject("setpoint: crashed")
+        return
+    if _repeated_setpoint(vehicle, msg):
+        vehicle.counters.reject("setpoint: repeated")
         return
     problem = setpoint_problem(msg, vehicle.armed and vehicle.mode == modes.GUIDED)
     target = ned_to_enu(np.array([msg.x, msg.y, msg.z], dtype=float))
@@ -46,6 +52,19 @@ def on_setpoint(vehicle: Any, msg: Any) -> None:
     if vehicle.failsafe:
         vehicle.failsafe = False
         vehicle.notify(mavlink2.MAV_SEVERITY_NOTICE, "Failsafe cleared: setpoints resumed")
+
+
+def _repeated_setpoint(vehicle: Any, msg: Any) -> bool:
+    """Whether this stamped setpoint is its sender's last one again (noting it if not)."""
+    stamp = int(msg.time_boot_ms)
+    if not stamp:
+        return False
+    sender = (msg.get_srcSystem(), msg.get_srcComponent())
+    seen = (stamp, msg.type_mask, msg.coordinate_frame, msg.x, msg.y, msg.z)
+    if vehicle.last_setpoint_seen.get(sender) == seen:
+        return True
+    vehicle.last_setpoint_seen[sender] = seen
+    return False
 
 
 def warn_once(vehicle: Any, text: str) -> None:

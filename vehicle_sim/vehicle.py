@@ -88,6 +88,7 @@ class Vehicle:
         self.last_setpoint_s = 0.0
         self.last_warning = ("", -math.inf)  # the last warning said, and when
         self.last_estimate_usec: dict[tuple[int, int], int] = {}  # per sender: the last taken
+        self.last_setpoint_seen: dict[tuple[int, int], tuple] = {}  # per sender: stamp, content
         vs = scenario.vehicle
         self.step_s = scenario.control.t_cont_s
         self.speed_limit_m_s = (

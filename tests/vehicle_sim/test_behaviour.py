@@ -64,6 +64,30 @@ def test_work_uav_is_slower_and_a_wrong_estimate_moves_the_truth_wrongly(frame):
     np.testing.assert_allclose(believed, target, atol=1e-4)
 
 
+def test_a_stamped_setpoint_sent_again_is_ignored_and_a_new_one_is_taken(frame):
+    """A batch sent again after the vehicle stepped on the first carries its setpoint again:
+    ignored (counted), where a new setpoint with the same stamp, or an unstamped one, is
+    taken."""
+    home = np.array([0.0, 0.0, 6.0])
+    first, second = home + [1.0, 0.0, 0.0], home + [0.0, 1.0, 0.0]
+    with vehicle_process("work", home=tuple(home)) as vehicle:
+        client = MavClient(vehicle.address)
+        client.arm_guided(1)
+        client.estimate(home, usec=1)
+        client.setpoint(1, first, time_boot_ms=STEP_MS)
+        client.step_to(STEP_MS)
+        client.setpoint(1, first, time_boot_ms=STEP_MS)  # the same datagram again: ignored
+        client.setpoint(1, second, time_boot_ms=STEP_MS)  # another target, same stamp: taken
+        client.setpoint(1, second)  # unstamped: taken however often it comes
+        for k in range(2, 12):
+            client.setpoint(1, second, time_boot_ms=STEP_MS * k)  # streamed, as a station does
+            messages = client.step_to(STEP_MS * k)
+        client.close()
+        said = vehicle.stop()
+    np.testing.assert_allclose(_believed(messages), second, atol=1e-4)
+    assert "'setpoint: repeated': 1" in said
+
+
 def test_an_estimate_stamped_no_later_than_the_last_taken_is_ignored(frame):
     """A datagram delivered twice (or overtaken) would set the belief back after the vehicle
     moved on: the vehicle takes an estimate only if its sender stamped it later than the last
