@@ -28,6 +28,13 @@ def test_ci_runs_the_readmes_test_command():
     _, tests = _two_commands()
     install, run = (shlex.split(part) for part in tests.split("&&"))
     assert install == ["python", "-m", "pip", "install", "-e", ".[test]"]
-    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
-    assert "-m pip install --quiet --disable-pip-version-check -e '.[test]'" in ci
-    assert ci.rstrip().endswith('"$PYTHON" ' + " ".join(run[1:]))
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    assert "\"$PYTHON\" -m pip install --quiet --disable-pip-version-check -e '.[test]'" in ci
+    assert '"$PYTHON" ' + " ".join(run[1:]) in ci
+
+
+def test_ci_runs_the_determinism_tests_again_with_narrowed_kernels():
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    readme_tests = ci.index('"$PYTHON" -m pytest -q')
+    again = [line for line in ci[readme_tests:] if "-m determinism" in line]
+    assert again and again[0].startswith("env $NARROWED "), again

@@ -24,6 +24,7 @@ pytestmark = pytest.mark.slow  # every test here starts processes
 LOCKSTEP_DECISIONS = "469a10ad51a85533"
 
 
+@pytest.mark.determinism
 def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
     """In the paper's form (no margins, contacts flown through), as the digest was taken."""
     scenario = tmp_path / "short-run.yaml"

@@ -41,6 +41,7 @@ def _paper_form(tmp_path: Path, stop: bool) -> Path:
     return path
 
 
+@pytest.mark.determinism
 def test_the_papers_form_is_one_setting_away(tmp_path):
     result = mission("run", str(_paper_form(tmp_path, False)), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
