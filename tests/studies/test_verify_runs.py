@@ -3,6 +3,7 @@ two rows of Table 3 (our defaults and the paper's form) made again and compared.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,7 @@ import pytest
 from mission.studies.canary import canary_record, canary_runs
 from mission.studies.local_engine import LocalEngine
 from mission.studies.provenance_file import read_provenance
+from mission.studies.results import read_results_csv
 from mission.studies.runkeys import code_version
 from tests.processes import ROOT, mission
 
@@ -67,3 +69,18 @@ def test_two_rows_of_table3_are_made_again_as_committed(study, canary, tmp_path)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "2 of 2 rows compared: 0 differ" in result.stdout
     assert "as when the study was made" in result.stdout
+
+
+def test_a_run_with_the_mpc_helper_decides_as_the_studys_without(along_run):
+    """`mission run along` on two cores shares the support MPCs with a helper process, split
+    by their last solve times; the Table 3 study's runs (two at a time) have none. The same
+    run either way."""
+    summary = json.loads((along_run / "summary.json").read_text())
+    committed = read_results_csv((COMMITTED / "table3" / "results.csv").read_text())
+    row = next(
+        r for r in committed if (r["scenario"], r["method"], r["seed"]) == ("along", "ac", 0)
+    )
+    assert summary["decisions_digest"] == row["decisions_digest"]
+    assert summary["control_cycles"] == row["control_cycles"]
+    assert summary["multipath_steps_total"] == row["multipath_steps_total"]
+    assert summary["lockstep"]["exact"]
