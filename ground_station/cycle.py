@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -32,6 +32,7 @@ from ground_station.align import align
 from ground_station.arrival import check_arrival
 from ground_station.fusion import FusionResult, SupportMeasurement, fuse
 from ground_station.gnss_map import learn
+from ground_station.integrity.monitor import Verdict
 from ground_station.localize import SupportReport, localize
 from ground_station.plan import FormationPlan, plan, solve_supports
 from ground_station.roles.allocation import allocate
@@ -55,6 +56,7 @@ class CycleDecision:
     formation: FormationPlan
     elapsed_ms: float
     own_fix: OwnFix | None = None  # the verdict on the work UAV's own fix (policy dynamic)
+    integrity: Verdict | None = None  # the integrity monitor's, where it is on
 
     @property
     def blind(self) -> bool:
@@ -81,6 +83,7 @@ class CycleOutput:
     support_plans: dict[str, SupportPlan]
     cycle_ms: float
     own_fix: OwnFix | None = None
+    integrity: Verdict | None = None
 
     @property
     def blind(self) -> bool:
@@ -104,7 +107,7 @@ def control_cycle(
     start = time.perf_counter()
     control, roles = context.scenario.control, context.scenario.roles
     measurements = localize(align(reports, state, control.t_cont_s), context.world)  # 1
-    fusion, betas = fuse(state, measurements, context.scenario.fusion, context.rng)  # 2
+    fusion, betas, verdict, fused = _checked_fusion(state, measurements, context)  # 2
     own = None
     if roles.policy == "dynamic":
         own = judge(work_fix, fusion, context.g, context.world, roles)
@@ -113,12 +116,40 @@ def control_cycle(
             state.xhat = combined_estimate(work_fix, own, fusion)
     blind = is_blind(fusion, own)  # then no waypoint is reached
     arrived = None if blind else check_arrival(state, context.work_waypoints, control.arrival_tol_m)
-    updated = learn(context.g, measurements, state.yhat)  # 4
+    updated = learn(context.g, fused, state.yhat)  # 4
+    if verdict is not None and context.integrity is not None:
+        updated += context.integrity.learn_excluded(
+            context.g, measurements, state.yhat, verdict.events
+        )
     allocate(state, context, state.allocation)
     members = state.allocation.members([m.name for m in measurements])
     formation = plan(state, context, members, hold=blind)  # 5
     elapsed_ms = (time.perf_counter() - start) * 1000
-    return CycleDecision(measurements, fusion, betas, arrived, updated, formation, elapsed_ms, own)
+    return CycleDecision(
+        measurements, fusion, betas, arrived, updated, formation, elapsed_ms, own, verdict
+    )
+
+
+def _checked_fusion(
+    state: StationState, measurements: list[SupportMeasurement], context: RunContext
+) -> tuple[FusionResult, dict[str, float | None], Verdict | None, list[SupportMeasurement]]:
+    """Step 2, with the integrity monitor's tests between localize and fuse where it is on:
+    a withheld support's fix is neither fused nor taken into its estimate. Returns the
+    fusion, each support's beta_n, the monitor's verdict (None: off) and the measurements as
+    fused."""
+    settings, monitor = context.scenario.fusion, context.integrity
+    if monitor is None:
+        return *fuse(state, measurements, settings, context.rng), None, measurements
+    verdict = monitor.check(measurements, state)
+    fused = [withheld(m) if m.name in verdict.withheld else m for m in measurements]
+    fusion, betas = fuse(state, fused, settings, context.rng)
+    found = monitor.settle(measurements, state, fusion, verdict)
+    return fusion, betas, verdict.with_events(found), fused
+
+
+def withheld(measurement: SupportMeasurement) -> SupportMeasurement:
+    """A support's measurement without its fix: not fused, dead-reckoned by the feedback."""
+    return replace(measurement, fix_m=None, sigma_gnss_m2=None)
 
 
 def complete_cycle(
@@ -138,6 +169,7 @@ def complete_cycle(
         plans,
         decision.elapsed_ms + (time.perf_counter() - start) * 1000,
         decision.own_fix,
+        decision.integrity,
     )
 
 

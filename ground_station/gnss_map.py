@@ -19,6 +19,8 @@ from ground_station.fusion import SupportMeasurement
 from mission.config.settings import MapSettings
 from mission.world.grid import VoxelGrid
 
+Change = tuple[tuple[np.ndarray, ...], np.ndarray]  # voxel indices, what was added to each
+
 
 class LocalizabilityMap:
     """G over a voxel grid; ``adaptive=False`` (the NAC baseline) switches the update off."""
@@ -40,12 +42,17 @@ class LocalizabilityMap:
 
         Returns how many voxels changed (0 for NAC, or when yhat lies outside the grid).
         """
+        return self.update_recorded(fix, yhat)[0]
+
+    def update_recorded(self, fix: np.ndarray, yhat: np.ndarray) -> tuple[int, Change | None]:
+        """:meth:`update`, and what it changed (the voxels and what was added to each), for
+        :meth:`take_back`; None where nothing changed."""
         if not self.adaptive:
-            return 0
+            return 0, None
         lo = self.grid.origin_m
         hi = lo + self.grid.voxel_m * np.array(self.grid.shape)
         if np.any(yhat < lo) or np.any(yhat >= hi):
-            return 0
+            return 0, None
         error = float(np.linalg.norm(np.asarray(fix) - np.asarray(yhat)))
         centre = self.grid.index_of(np.asarray(yhat)[None])[0]
         index = centre + self._offsets
@@ -56,8 +63,16 @@ class LocalizabilityMap:
         else:
             weight = (d2 == 0).astype(float)
         cells = tuple(index.T)
-        self.values[cells] += self.settings.eta * (error - self.values[cells]) * weight
-        return int(np.count_nonzero(weight))
+        added = self.settings.eta * (error - self.values[cells]) * weight
+        self.values[cells] += added
+        return int(np.count_nonzero(weight)), (cells, added)
+
+    def take_back(self, changes: Sequence[Change]) -> None:
+        """Undo updates (latest first): what a support that turned out to carry its bias
+        with it (a receiver at fault, not a place) taught G. Updates others made to the same
+        voxels meanwhile stay, as they were computed (on values that held this support's)."""
+        for cells, added in reversed(changes):
+            self.values[cells] -= added
 
     def smoothed(self, points: np.ndarray) -> np.ndarray:
         """G_s at points (N, 3), in numpy."""

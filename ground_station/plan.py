@@ -129,6 +129,7 @@ def support_request(
         state.warm.get(name),
         escape=escape,
         others=others_predicted(state, name, work, context.scenario.control.horizon_steps),
+        widen_m=context.integrity.extra_margin_m(name) if context.integrity else 0.0,
     )
 
 

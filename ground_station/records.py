@@ -76,6 +76,8 @@ class RunRecords:
             record["own_fix"] = output.own_fix.record()
         if state.allocation.supports:  # the supports have inspections of their own
             record["roles"] = state.allocation.record()
+        if output.integrity is not None:  # integrity.enabled
+            record["integrity"] = output.integrity.record()
         if ages_ms is not None:
             record["age_ms"] = ages_ms
         self._records.write(json.dumps(record) + "\n")

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ground_station.gnss_map import LocalizabilityMap
+from ground_station.integrity.monitor import IntegrityMonitor
 from ground_station.state import StationState
 from ground_station.support_mpc.mpc import SupportMpc
 from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
@@ -31,6 +32,7 @@ class RunContext:
     planner: LocalPlanner  # solves the support MPCs: here, or shared with a helper process
     inspections: dict[str, np.ndarray] = field(default_factory=dict)  # support -> (n, 3)
     routes: RouteMap | None = None  # None without inspections
+    integrity: IntegrityMonitor | None = None  # None where the monitor is off
 
 
 def build_run_context(
@@ -67,6 +69,7 @@ def build_run_context(
         planner,
         inspections,
         route_map(world, sigma0) if inspections else None,
+        _monitor(scn),
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),
@@ -74,6 +77,13 @@ def build_run_context(
         k=min(1, len(waypoints["work"]) - 1),
     )
     return context, state
+
+
+def _monitor(scenario: Scenario) -> IntegrityMonitor | None:
+    """The integrity monitor where the scenario has it on."""
+    if not scenario.integrity.enabled:
+        return None
+    return IntegrityMonitor(scenario.integrity, scenario.vehicle.dynamics == "multicopter")
 
 
 def require_known_world(world: KnownWorld) -> KnownWorld:

@@ -161,8 +161,12 @@ class GroundStation:
                 return None
             for name in self.links.supervise(self.config.silence_limit_s, self.clock.step_s):
                 state.forget(name)
+                if context.integrity is not None:
+                    context.integrity.forget(name)
             reports = reports_from_messages(self.links.support_samples(), self.frame)
             decision = control_cycle(state, reports, context, self._work_fix())
+            for event in decision.integrity.events if decision.integrity else ():
+                self.links.announce(event.text)
             work_step = self._command_work(state, decision)  # it steps while
             output = complete_cycle(state, decision, context)  # the supports' MPCs are solved
             self._command_supports(state, output)

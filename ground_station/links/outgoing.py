@@ -69,11 +69,6 @@ def command_long(
     return mavlink2.MAVLink_command_long_message(system_id, 1, command, 0, *values)
 
 
-def statustext(text: str) -> mavlink2.MAVLink_statustext_message:
-    """An INFO STATUSTEXT (text cut to the field's 50 bytes)."""
-    return mavlink2.MAVLink_statustext_message(mavlink2.MAV_SEVERITY_INFO, text.encode()[:50], 0, 0)
-
-
 def timesync_request(now_ns: int) -> mavlink2.MAVLink_timesync_message:
     """A TIMESYNC request (tc1 = 0) stamped with the ground station's time in nanoseconds."""
     return mavlink2.MAVLink_timesync_message(0, now_ns)

@@ -25,12 +25,12 @@ from ground_station.links.outgoing import (
     GCS_SYSTEM_ID,
     GUIDED_AND_ARMED,
     command_long,
-    statustext,
     timesync_request,
 )
 from ground_station.links.tlog import TlogWriter
 from mission.link.impairment import LinkSettings
 from mission.link.mavlink_udp import Address, MavlinkCodec, MessageQueue, UdpEndpoint
+from mission.link.statustext import statustexts
 from mission.link.vehicle_identity import VehicleIdentity
 
 TRUTH_KINDS = frozenset({"SIM_STATE"})  # logged, never kept
@@ -85,6 +85,7 @@ class VehicleLinks:
     ) -> None:
         self.clock = clock
         self.tlog = tlog
+        self._statustext_id = 0  # the last id of a STATUSTEXT sent in chunks
         self.endpoint = UdpEndpoint(
             MavlinkCodec(GCS_SYSTEM_ID, GCS_COMPONENT_ID, signing_key),
             link=link,
@@ -147,7 +148,9 @@ class VehicleLinks:
             print(
                 f"ground station: t={self.clock.time_s:.1f} s: {text}", file=sys.stderr, flush=True
             )
-        self.tlog.write(self.clock.time_usec, self.endpoint.send(statustext(text), []))
+        self._statustext_id = self._statustext_id % 65535 + 1
+        for message in statustexts(text, self._statustext_id):
+            self.tlog.write(self.clock.time_usec, self.endpoint.send(message, []))
 
     # -- in ---------------------------------------------------------------------------------
     def receive(self, message: Any, sender: Address) -> None:

@@ -199,3 +199,17 @@ def _dot(a, b) -> float:
     """a.b of two 3-vectors, summed left to right (the same on every CPU; numpy's einsum
     sums in an order its SIMD width picks)."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def widened(parameters: np.ndarray, extra_m: float) -> np.ndarray:
+    """Margin parameters (:meth:`Margins.parameters`: every slot's normal, then every slot's
+    offset) with each used half-space moved ``extra_m`` further out (n.v >= b + extra_m, the
+    normals being unit vectors); unused slots (n = 0) stay unused."""
+    slots = len(parameters) // 4
+    if slots == 0:
+        return parameters
+    normals = parameters[: 3 * slots].reshape(slots, 3)
+    used = np.linalg.norm(normals, axis=1) > 0.5
+    out = np.array(parameters, dtype=float)
+    out[3 * slots :] += np.where(used, extra_m, 0.0)
+    return out

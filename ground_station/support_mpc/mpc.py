@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ground_station.support_mpc.los_anchors import LosAnchors
-from ground_station.support_mpc.margins import Margins
+from ground_station.support_mpc.margins import Margins, widened
 from ground_station.support_mpc.nlp import MARGIN_WEIGHT, SOFT, build_support_nlp
 from mission.config.resources import mpc_window_shape
 from mission.config.settings import ControlSettings
@@ -56,6 +56,7 @@ class PlanRequest:
     warm_start: np.ndarray | None
     escape: bool
     others: np.ndarray | None = None  # (m, U, 3): the other UAVs' predicted positions
+    widen_m: float = 0.0  # every margin this much wider (an excluded support: integrity)
 
 
 @dataclass(frozen=True)
@@ -172,9 +173,11 @@ class SupportMpc:
         warm_start: np.ndarray | None = None,
         escape: bool = False,
         others: np.ndarray | None = None,
+        widen_m: float = 0.0,
     ) -> PlanRequest:
         """Everything one support's solve needs, G cut down to the window around yhat;
-        ``others`` (m, U, 3): the other UAVs' predicted positions, for the separation."""
+        ``others`` (m, U, 3): the other UAVs' predicted positions, for the separation;
+        ``widen_m``: how much wider than the scenario's its margins are."""
         horizon = self.horizon
         corner, window = self.window_of(yhat, g_values)
         return PlanRequest(
@@ -188,6 +191,7 @@ class SupportMpc:
             warm_start,
             escape,
             others,
+            widen_m,
         )
 
     def plan(self, request: PlanRequest, observable) -> SupportPlan:
@@ -229,7 +233,8 @@ class SupportMpc:
     def _margin_parameters(self, request: PlanRequest, guess: np.ndarray) -> np.ndarray:
         """The margins' half-spaces linearised at ``guess`` (none without margins)."""
         others = np.zeros((0, self.horizon, 3)) if request.others is None else request.others
-        return self.margins.parameters(guess, request.yhat, others)
+        spaces = self.margins.parameters(guess, request.yhat, others)
+        return widened(spaces, request.widen_m) if request.widen_m > 0 else spaces
 
     def _initial_guess(
         self, yhat: np.ndarray, terminal: np.ndarray, warm_start: np.ndarray | None

@@ -32,6 +32,7 @@ from mission.analysis.tracking import tracking_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, truth_time
 from mission.config.settings import Scenario
 from mission.link.fast_decode import FastDecoder
+from mission.link.statustext import StatusChunks
 from mission.link.vehicle_events import parse_event
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame, ned_to_enu
@@ -80,6 +81,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     pending_estimate: tuple[float, np.ndarray] | None = None
     samples = _StepSamples()
     replies: list[TimesyncReply] = []
+    chunks = StatusChunks()  # the ground station's long STATUSTEXTs
     for message in messages:
         kind = message.get_type()
         t = round(message._timestamp - epoch, 3)
@@ -119,7 +121,9 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "SYSTEM_TIME" and message.time_boot_ms > 0:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
         elif kind == "STATUSTEXT":
-            _station_said(trace, message.text, t)
+            text = chunks.add(message)
+            if text is not None:
+                _station_said(trace, text, t)
     offsets = {} if trace.ticks else clock_offsets(replies)
     epoch_usec = round(epoch * 1e6)
     for kind, into in ((TRUTH, trace.truth), (BELIEF, trace.beliefs)):

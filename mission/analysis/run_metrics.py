@@ -9,6 +9,7 @@ from typing import Any
 
 from mission.analysis.decisions import decisions_digest
 from mission.analysis.diagnostics import diagnostics, read_records
+from mission.analysis.integrity import integrity_metrics
 from mission.analysis.metrics import (
     RunTrace,
     measurement_ages,
@@ -38,5 +39,8 @@ def metrics_of(trace: RunTrace, world: World, run_dir: Path, scenario: Scenario)
         metrics["mpc_solve_ms"] = mpc_stats(records)
         metrics["diagnostics"] = diagnostics(trace, records, world, scenario)
         metrics["roles"] = role_metrics(trace, records, world, scenario)
+        found = integrity_metrics(trace, records, world, metrics.get("events") or [])
+        if found is not None:  # the integrity monitor was on
+            metrics["integrity"] = found
         metrics["decisions_digest"] = decisions_digest(records)
     return metrics

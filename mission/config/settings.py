@@ -16,6 +16,7 @@ from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
 from mission.config.errors import FieldProblem
 from mission.config.fault_settings import Fault, check_faults
+from mission.config.integrity_settings import IntegritySettings
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
 from mission.config.role_settings import (
@@ -355,9 +356,11 @@ class Scenario:
     limits: LimitSettings
     faults: list[Fault]
     roles: RoleSettings
+    integrity: IntegritySettings
 
     def __post_init__(self) -> None:
         self._check_margins()
+        self._check_integrity()
         check_faults(self.faults, self.task.supports, self.run.timeout_s)
         for i, point in enumerate(self.task.work_waypoints_m):
             box = self.world.workspace
@@ -365,6 +368,18 @@ class Scenario:
             _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")
         check_inspections(self.task.inspections, self.task.supports, self.world.workspace)
         check_roles(self.roles, self.task.supports)
+
+    def _check_integrity(self) -> None:
+        """The monitor's sustain and recovery fit in the run."""
+        cycles = self.run.timeout_s / self.control.t_cont_s
+        for name in ("sustain_cycles", "recovery_cycles"):
+            value = getattr(self.integrity, name)
+            _require(
+                value <= cycles,
+                f"integrity.{name}",
+                f"{value} cycles is longer than the run ({cycles:g} cycles of "
+                f"{self.control.t_cont_s:g} s in run.timeout_s {self.run.timeout_s:g} s)",
+            )
 
     def _check_margins(self) -> None:
         """A margin, where there is one, leaves room for the bodies it keeps apart."""

@@ -86,6 +86,35 @@ FILE_CASES = [
         lambda t: [*RUN, str(scenario_file(t, "roles: {keep_in_formation: 4}\n"))],
         ["bad.yaml", "roles.keep_in_formation", "more than the scenario's 3 supports"],
     ),
+    # --- the integrity monitor -----------------------------------------------------------
+    (
+        "yaml-integrity-false-alarm-zero",
+        lambda t: [*RUN, str(scenario_file(t, "integrity: {false_alarm: 0}\n"))],
+        ["bad.yaml", "integrity.false_alarm", "probability"],
+    ),
+    (
+        "yaml-integrity-missed-detection-nan",
+        lambda t: [*RUN, str(scenario_file(t, "integrity: {missed_detection: .nan}\n"))],
+        ["bad.yaml", "integrity.missed_detection", "finite"],
+    ),
+    (
+        "yaml-integrity-sustain-longer-than-the-run",
+        lambda t: [
+            *RUN,
+            str(scenario_file(t, "run: {timeout_s: 10}\nintegrity: {sustain_cycles: 30}\n")),
+        ],
+        ["bad.yaml", "integrity.sustain_cycles", "longer than the run"],
+    ),
+    (
+        "yaml-integrity-unknown-key",
+        lambda t: [*RUN, str(scenario_file(t, "integrity: {gates: 3}\n"))],
+        ["bad.yaml", "integrity.gates", "unknown key"],
+    ),
+    (
+        "yaml-integrity-motion-sigma-infinite",
+        lambda t: [*RUN, str(scenario_file(t, "integrity: {motion_sigma_m: .inf}\n"))],
+        ["bad.yaml", "integrity.motion_sigma_m", "finite"],
+    ),
     # --- safety margins ----------------------------------------------------------------
     (
         "yaml-negative-margin",

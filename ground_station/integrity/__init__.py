@@ -1,0 +1,1 @@
+"""Integrity: each support's fix tested, excluded, restored. Imports: config, ground_station."""

@@ -1,0 +1,136 @@
+"""What the integrity monitor did in a run, judged against what only the simulation knows:
+summary.json's ``integrity`` block (where the monitor was on).
+
+From the ground station's records: each exclusion (its test, the bias it saw, the test's
+minimal detectable bias), restoration and receiver call, and the cycles each support was
+excluded or withheld. From the tlog's truth and the vehicles' events:
+
+- a **lying fault** is a window in which a support's receiver gave a wrong fix: a glitch
+  parameter (``SIM_GPS1_GLTCH_X/Y/Z``) away from 0, or a GNSS failure that reports a fix
+  (``stuck``, ``wrong``, ``delayed``); ``off`` and ``garbage`` give no fix to test;
+- **time to detect**: from a fault's start to the first cycle at which its support was
+  excluded (0 where it was excluded already); a fault during which its support was never
+  excluded is a **missed detection**;
+- a **false alarm** is an exclusion with no lying fault on that support and no zone bias at
+  its true position; an exclusion in a zone (a real bias, if often below the test's minimal
+  detectable bias in its worst direction) is a **zone exclusion**.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from typing import Any
+
+import numpy as np
+
+from mission.analysis.trace import RunTrace
+from mission.link.vehicle_identity import VehicleIdentity
+from mission.world.model import World
+
+GLITCH_PARAMETERS = ("SIM_GPS1_GLTCH_X", "SIM_GPS1_GLTCH_Y", "SIM_GPS1_GLTCH_Z")
+LYING_FAILURES = ("gps stuck", "gps wrong", "gps delayed")
+
+
+def integrity_metrics(
+    trace: RunTrace, records: list[dict[str, Any]], world: World, events: list[dict[str, Any]]
+) -> dict[str, Any] | None:
+    """The ``integrity`` block (None where no record has the monitor's verdict)."""
+    verdicts = [(r["t"], r["integrity"]) for r in records if "integrity" in r]
+    if not verdicts:
+        return None
+    end_s = verdicts[-1][0]
+    faults = lying_faults(events, end_s)
+    excluded_at: dict[str, list[float]] = defaultdict(list)
+    withheld: dict[str, int] = defaultdict(int)
+    exclusions, restorations, receivers = [], 0, 0
+    for t, verdict in verdicts:
+        for name in verdict["excluded"]:
+            excluded_at[name].append(t)
+        for name in verdict["withheld"]:
+            withheld[name] += 1
+        for event in verdict["events"]:
+            if event["kind"] == "excluded":
+                exclusions.append((t, event))
+            restorations += event["kind"] == "restored"
+            receivers += event["kind"] == "receiver"
+    detection = _detections(faults, excluded_at)
+    false_alarms, in_zones = _unfaulted(trace, world, exclusions, faults)
+    return {
+        "exclusions": len(exclusions),
+        "restorations": restorations,
+        "receiver_calls": receivers,
+        "excluded_cycles": {name: len(times) for name, times in sorted(excluded_at.items())},
+        "withheld_cycles": dict(sorted(withheld.items())),
+        "ambiguous_cycles": sum(1 for _, v in verdicts if v["ambiguous"]),
+        "lying_faults": sum(len(windows) for windows in faults.values()),
+        "time_to_detect_s": detection["delays"],
+        "missed_detections": detection["missed"],
+        "false_alarms": false_alarms,
+        "zone_exclusions": in_zones,
+    }
+
+
+def lying_faults(events: list[dict[str, Any]], end_s: float) -> dict[str, list[list[float]]]:
+    """Per support, the [start, end] windows in which its receiver lied."""
+    active: dict[tuple[str, str], float] = {}
+    windows: dict[str, list[list[float]]] = defaultdict(list)
+    for event in sorted(events, key=lambda e: e["t"]):
+        vehicle, what = event["vehicle"], event["event"]
+        name, _, value = what.partition("=")
+        if name in GLITCH_PARAMETERS:
+            key, starts = (vehicle, name), _nonzero(value)
+        elif what.startswith("gps "):
+            key, starts = (vehicle, "gps"), what in LYING_FAILURES
+        else:
+            continue
+        if key in active and not starts:
+            windows[vehicle].append([active.pop(key), event["t"]])
+        elif starts and key not in active:
+            active[key] = event["t"]
+    for (vehicle, _), start in active.items():
+        windows[vehicle].append([start, end_s])
+    return {vehicle: sorted(spans) for vehicle, spans in windows.items()}
+
+
+def _nonzero(value: str) -> bool:
+    try:
+        return float(value) != 0.0
+    except ValueError:
+        return False
+
+
+def _detections(
+    faults: dict[str, list[list[float]]], excluded_at: dict[str, list[float]]
+) -> dict[str, Any]:
+    delays: list[float] = []
+    missed = 0
+    for name, windows in faults.items():
+        times = excluded_at.get(name, [])
+        for start, end in windows:
+            during = [t for t in times if start <= t <= end]
+            if during:
+                delays.append(round(during[0] - start, 3))
+            else:
+                missed += 1
+    return {"delays": delays, "missed": missed}
+
+
+def _unfaulted(
+    trace: RunTrace,
+    world: World,
+    exclusions: list[tuple[float, dict[str, Any]]],
+    faults: dict[str, list[list[float]]],
+) -> tuple[int, int]:
+    """(false alarms, zone exclusions) among the exclusions with no lying fault on the
+    support: those with no zone bias at its true position, and those with one."""
+    false_alarms = in_zones = 0
+    for t, event in exclusions:
+        name = event["support"]
+        if any(start <= t <= end for start, end in faults.get(name, [])):
+            continue
+        system = VehicleIdentity.parse(name).system_id
+        truth, known = trace.truth_at(system, [t])
+        biased = bool(known[0]) and bool(np.any(world.zone_offset(truth[:1])[0] != 0))
+        in_zones += biased
+        false_alarms += not biased
+    return false_alarms, in_zones

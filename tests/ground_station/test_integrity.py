@@ -1,0 +1,198 @@
+"""The integrity monitor against hand computations: the chi-square arithmetic against scipy,
+a cycle with a known bias giving its statistic by hand, the flag raised at the gate and not
+below, the liar told apart (or not), restoration, a bias that follows its support taken back
+from G, and an excluded support's wider margins."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from ground_station.fusion import SupportMeasurement
+from ground_station.gnss_map import LocalizabilityMap
+from ground_station.integrity.chi_square import (
+    detectable_noncentrality,
+    gate,
+    noncentral_cdf_3,
+    survival,
+)
+from ground_station.integrity.monitor import IntegrityMonitor
+from ground_station.state import StationState
+from ground_station.support_mpc.margins import widened
+from mission.config.settings import MapSettings
+from mission.world.grid import VoxelGrid
+
+SIGMA_GNSS = np.diag([0.01, 0.01, 0.04])  # m^2
+SIGMA_R = np.diag([0.0025, 0.0025, 0.0025])
+PREVIOUS = np.diag([0.02, 0.02, 0.05])  # the last estimate's covariance
+Q = 0.05  # motion_sigma_m
+
+
+@pytest.mark.parametrize("dof", [1, 2, 3, 4, 6, 9])
+def test_the_survival_function_and_its_gate_are_scipys(dof):
+    for x in (0.1, 2.0, 11.3, 25.9, 80.0):
+        assert survival(x, dof) == pytest.approx(stats.chi2.sf(x, dof), rel=1e-10, abs=1e-300)
+    for rate in (1e-2, 1e-5, 1e-9):
+        assert gate(rate, dof) == pytest.approx(stats.chi2.isf(rate, dof), rel=1e-9)
+
+
+def test_the_noncentral_distribution_and_the_detectable_bias_are_scipys():
+    for x, lam in ((25.9, 0.5), (25.9, 40.0), (3.0, 3.0), (60.0, 64.0)):
+        assert noncentral_cdf_3(x, lam) == pytest.approx(stats.ncx2.cdf(x, 3, lam), rel=1e-9)
+    lam = detectable_noncentrality(1e-5, 1e-3)
+    assert stats.ncx2.cdf(stats.chi2.isf(1e-5, 3), 3, lam) == pytest.approx(1e-3, rel=1e-6)
+
+
+def _settings(along, **changes):
+    base = dataclasses.replace(along.integrity, enabled=True, motion_sigma_m=Q)
+    return dataclasses.replace(base, **changes)
+
+
+def _support(name, fix, relative=None) -> SupportMeasurement:
+    return SupportMeasurement(
+        name,
+        np.array(fix, dtype=float),
+        SIGMA_GNSS,
+        None if relative is None else np.array(relative, dtype=float),
+        None if relative is None else SIGMA_R,
+    )
+
+
+def _primed(along, names=("support-1",), **changes) -> tuple[IntegrityMonitor, StationState]:
+    """A monitor that has seen one cycle: each support at the origin, last covariance known,
+    commanded 0.3 m east."""
+    monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False)
+    state = StationState(np.zeros(3), {n: np.zeros(3) for n in names}, 1)
+    for name in names:
+        monitor.watch(name).covariance = PREVIOUS.copy()
+        state.last_support_command[name] = np.array([0.3, 0.0, 0.0])
+    return monitor, state
+
+
+def _motion_statistic_by_hand(bias: np.ndarray) -> float:
+    variances = np.diag(SIGMA_GNSS) + np.diag(PREVIOUS) + Q**2
+    return float(np.sum(bias**2 / variances))
+
+
+def test_a_known_step_gives_its_statistic_by_hand_and_is_excluded_at_the_gate(along):
+    gate_1 = gate(1e-5, 3)
+    for scale, excluded in ((0.99, False), (1.01, True)):
+        monitor, state = _primed(along, sustain_cycles=1)
+        direction = np.array([1.0, 0.0, 0.0])
+        variance = SIGMA_GNSS[0, 0] + PREVIOUS[0, 0] + Q**2
+        bias = direction * np.sqrt(scale * gate_1 * variance)  # T = scale x the gate
+        fix = np.array([0.3, 0.0, 0.0]) + bias
+        verdict = monitor.check([_support("support-1", fix)], state)
+        statistic = verdict.statistics["support-1"]["motion"]
+        assert statistic == pytest.approx(_motion_statistic_by_hand(bias), rel=1e-12)
+        assert statistic == pytest.approx(scale * gate_1, rel=1e-9)
+        assert ("support-1" in verdict.excluded) is excluded
+        assert "support-1" in verdict.withheld  # over the suspect gate either way
+        if excluded:
+            size = f"{np.linalg.norm(bias):.1f}"  # 0.9 m
+            assert (
+                verdict.events[0].text == f"Integrity: support-1 excluded (motion test, {size} m)"
+            )
+
+
+def test_a_smaller_bias_is_excluded_once_two_cycles_sum_past_their_gate(along):
+    monitor, state = _primed(along, sustain_cycles=2)
+    one, two = gate(1e-5, 3), gate(1e-5, 6)
+    variance = SIGMA_GNSS[0, 0] + PREVIOUS[0, 0] + Q**2
+    bias = np.array([np.sqrt(0.6 * two * variance), 0.0, 0.0])  # 0.6 x gate_2 each: under one
+    assert 0.6 * two < one
+    first = monitor.check([_support("support-1", np.array([0.3, 0, 0]) + bias)], state)
+    assert not first.excluded and "support-1" in first.withheld
+    state.last_support_command["support-1"] = np.zeros(3)  # a withheld support: dead-reckoned
+    state.yhat["support-1"] = np.array([0.3, 0.0, 0.0])
+    second = monitor.check([_support("support-1", np.array([0.3, 0, 0]) + bias)], state)
+    assert second.excluded == {"support-1"}
+
+
+def _formation(biased: int, count: int, along, **changes):
+    names = tuple(f"support-{n + 1}" for n in range(count))
+    monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False)
+    state = StationState(np.zeros(3), {n: np.zeros(3) for n in names}, 1)
+    work = np.array([0.0, 0.0, 5.0])
+    supports = []
+    for n, name in enumerate(names):
+        position = np.array([3.0 * n - 3.0, 6.0, 7.0])
+        fix = position + (np.array([2.0, 0.0, 0.0]) if n == biased else 0.0)
+        supports.append(_support(name, fix, work - position))
+    return monitor, state, supports
+
+
+def test_with_three_supports_the_formation_test_blames_the_one_that_lies(along):
+    monitor, state, supports = _formation(biased=1, count=3, along=along, sustain_cycles=1)
+    verdict = monitor.check(supports, state)
+    assert verdict.excluded == {"support-2"} and not verdict.ambiguous
+    assert verdict.events[0].test == "formation"
+    # by hand: support-2 against the mean of the other two (equal covariances)
+    nu = supports[1].mu - (supports[0].mu + supports[2].mu) / 2
+    s = supports[1].sigma + (SIGMA_GNSS + SIGMA_R) / 2
+    assert verdict.statistics["support-2"]["formation"] == pytest.approx(
+        float(nu @ np.linalg.solve(s, nu)), rel=1e-12
+    )
+
+
+def test_two_supports_that_disagree_cannot_be_told_apart_and_both_are_withheld(along):
+    monitor, state, supports = _formation(biased=0, count=2, along=along)
+    verdict = monitor.check(supports, state)
+    assert verdict.ambiguous == ("support-1", "support-2")
+    assert verdict.withheld == {"support-1", "support-2"} and not verdict.excluded
+    assert not verdict.events
+
+
+def test_an_excluded_support_is_restored_after_its_quiet_cycles(along):
+    monitor, state = _primed(along, sustain_cycles=1, recovery_cycles=3)
+    big = np.array([0.3 + 2.2, 0.0, 0.0])
+    assert monitor.check([_support("support-1", big)], state).excluded == {"support-1"}
+    state.last_support_command["support-1"] = np.zeros(3)
+    state.yhat["support-1"] = np.array([0.3, 0.0, 0.0])
+    kinds = []
+    for _ in range(3):  # the fix is back where the support is
+        verdict = monitor.check([_support("support-1", [0.3, 0.0, 0.0])], state)
+        kinds += [event.kind for event in verdict.events]
+    assert kinds == ["restored"] and not verdict.excluded
+
+
+def test_a_bias_that_follows_its_support_is_its_receivers_and_g_forgets_it(along, along_world):
+    grid = VoxelGrid(origin_m=np.array([-20.0, -20.0, 0.0]), voxel_m=1.0, shape=(40, 40, 16))
+    settings = MapSettings(voxel_size_m=1.0, eta=0.3, neighborhood=1.5, no_fix_sigma_m=5.0)
+    g = LocalizabilityMap(grid, np.full(grid.shape, 0.15), settings)
+    before = g.values.copy()
+    monitor, state = _primed(along, sustain_cycles=1, receiver_travel_m=3.0)
+    work = np.array([0.0, 0.0, 5.0])
+    glitch = np.array([0.0, 2.2, 0.0])
+    events = []
+    for step in range(8):  # east at 1 m a cycle, its fix 2.2 m north all the way
+        position = np.array([float(step), 0.0, 6.0])
+        support = _support("support-1", position + glitch, work - position)
+        verdict = monitor.check([support], state)
+        if verdict.excluded:
+            state.yhat["support-1"] = position  # placed by the formation
+            events = list(verdict.events) + monitor.settle([support], state, _blind(), verdict)
+            monitor.learn_excluded(g, [support], state.yhat, events)
+        state.yhat["support-1"] = position
+        state.last_support_command["support-1"] = np.array([1.0, 0.0, 0.0])
+        if any(e.kind == "receiver" for e in events):
+            break
+    assert [e.kind for e in events if e.kind == "receiver"] == ["receiver"]
+    np.testing.assert_allclose(g.values, before, atol=1e-12)  # all it taught, taken back
+
+
+def _blind():
+    from ground_station.fusion import FusionResult
+
+    return FusionResult(None, (), (), False, np.zeros((0, 0)), ())
+
+
+def test_an_excluded_supports_margins_are_wider_and_unused_slots_stay_unused():
+    normals = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]  # three slots, the middle unused
+    offsets = [0.75, -1.0, 0.75]
+    out = widened(np.array(normals + offsets), 1.0)
+    np.testing.assert_allclose(out[:9], normals)
+    np.testing.assert_allclose(out[9:], [1.75, -1.0, 1.75])
