@@ -143,8 +143,7 @@ def _checked_fusion(
     verdict = monitor.check(measurements, state)
     fused = [withheld(m) if m.name in verdict.withheld else m for m in measurements]
     fusion, betas = fuse(state, fused, settings, context.rng)
-    found = monitor.settle(measurements, state, fusion, verdict)
-    return fusion, betas, verdict.with_events(found), fused
+    return fusion, betas, monitor.settle(measurements, state, fusion, verdict), fused
 
 
 def withheld(measurement: SupportMeasurement) -> SupportMeasurement:

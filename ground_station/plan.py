@@ -129,8 +129,16 @@ def support_request(
         state.warm.get(name),
         escape=escape,
         others=others_predicted(state, name, work, context.scenario.control.horizon_steps),
-        widen_m=context.integrity.extra_margin_m(name) if context.integrity else 0.0,
+        widen_m=_widened_by(context, name),
     )
+
+
+def _widened_by(context: RunContext, name: str) -> float:
+    """How much wider than the scenario's a support's margins are (the integrity monitor's
+    doubt; 0 where it is off)."""
+    if context.integrity is None:
+        return 0.0
+    return context.integrity.extra_margin_m(name, context.scenario.control.estimate_allowance_m)
 
 
 def others_predicted(

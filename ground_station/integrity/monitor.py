@@ -35,6 +35,11 @@ from ground_station.integrity.consistency import (
     formation_innovation,
     motion_innovation,
 )
+from ground_station.integrity.protection import (
+    detectable_bias,
+    fused_protection,
+    no_fault_radius,
+)
 from ground_station.state import StationState
 from mission.config.integrity_settings import IntegritySettings
 
@@ -54,6 +59,9 @@ class Watch:
     travel_m: float = 0.0  # how far its estimate went from there while excluded
     receiver: bool = False  # the bias followed it: its receiver's, not a place's
     taught: list[Change] = field(default_factory=list)  # what it taught G while excluded
+    motion_detectable_m: float | None = None  # its motion test's MDB this cycle
+    fault_m: float = 0.0  # the undetected bias its estimate may carry (protection radius)
+    protection_m: float | None = None  # its estimate's protection radius
 
 
 @dataclass(frozen=True)
@@ -95,10 +103,12 @@ class Verdict:
     withheld: frozenset[str]
     ambiguous: tuple[str, ...]
     events: tuple[Event, ...]
+    protection_m: dict[str, float | None] = field(default_factory=dict)  # work and supports
 
-    def with_events(self, found: Sequence[Event]) -> Verdict:
-        """The verdict with what the cycle found after the fusion."""
-        return replace(self, events=self.events + tuple(found))
+    def settled(self, found: Sequence[Event], protection: dict[str, float | None]) -> Verdict:
+        """The verdict with what the cycle found after the fusion, and the estimates'
+        protection radii."""
+        return replace(self, events=self.events + tuple(found), protection_m=protection)
 
     def record(self) -> dict:
         """What records.jsonl keeps of it."""
@@ -111,6 +121,10 @@ class Verdict:
             "withheld": sorted(self.withheld),
             "ambiguous": list(self.ambiguous),
             "events": [event.record() for event in self.events],
+            "protection_m": {
+                name: None if radius is None else round(radius, 3)
+                for name, radius in self.protection_m.items()
+            },
         }
 
 
@@ -128,6 +142,8 @@ class IntegrityMonitor:
         ]
         self.suspect_gate = gate(settings.false_alarm**SUSPECT_EXPONENT, 3)
         self.detectable = detectable_noncentrality(settings.false_alarm, settings.missed_detection)
+        self.k2 = gate(settings.missed_detection, 3)  # the no-fault radius's quantile
+        self.fault_detectable = fault_noncentrality(settings)
         self.watches: dict[str, Watch] = {}
 
     def watch(self, name: str) -> Watch:
@@ -171,11 +187,15 @@ class IntegrityMonitor:
 
     def _motion(self, support: SupportMeasurement, state: StationState) -> Innovation | None:
         watch = self.watch(support.name)
+        watch.motion_detectable_m = None
         previous = state.yhat.get(support.name)
         if watch.covariance is None or previous is None:
             return None
         moved = state.last_support_command.get(support.name, np.zeros(3))
-        return motion_innovation(support, previous, moved, watch.covariance, self.motion_sigma_m)
+        found = motion_innovation(support, previous, moved, watch.covariance, self.motion_sigma_m)
+        if found is not None:
+            watch.motion_detectable_m = detectable_bias(found.covariance, self.detectable)
+        return found
 
     def _formation(
         self, measurements: Sequence[SupportMeasurement], suspect_motion: set[str]
@@ -222,8 +242,7 @@ class IntegrityMonitor:
             watch.excluded, watch.consistent, watch.travel_m = True, 0, 0.0
             watch.since, watch.receiver, watch.taught = None, False, []
             found = present[test]
-            worst = float(np.linalg.eigvalsh(found.covariance)[-1])
-            detectable_m = float(np.sqrt(self.detectable * worst))
+            detectable_m = detectable_bias(found.covariance, self.detectable)
             return Event(name, "excluded", test, found.size_m, detectable_m)
         quiet = bool(present) and all(f.statistic <= self.suspect_gate for f in present.values())
         watch.consistent = watch.consistent + 1 if quiet else 0
@@ -252,33 +271,68 @@ class IntegrityMonitor:
         state: StationState,
         fusion: FusionResult,
         verdict: Verdict,
-    ) -> list[Event]:
+    ) -> Verdict:
         """After the fusion (which had no fix of the withheld supports, so dead-reckoned
         them): a withheld support that sees the work UAV is placed by the formation instead
-        (xhat - r_n); each support's estimate covariance for its next motion test; how far an
-        excluded support has gone, and, past ``receiver_travel_m``, its bias called its
-        receiver's. Returns those findings."""
-        q2 = self.motion_sigma_m**2 * np.eye(3)
+        (xhat - r_n); each estimate's covariance and protection radius; how far an excluded
+        support has gone, and, past ``receiver_travel_m``, its bias called its receiver's.
+        Returns the verdict with those findings and radii."""
+        used = [m for m in measurements if m.name in fusion.consistent and m.contributes]
+        scale = np.sqrt(self.fault_detectable / self.detectable)  # MDB at the fault's rate
+        motion_mdb = {m.name: self.watch(m.name).motion_detectable_m for m in used}
+        detected = {name: mdb * scale for name, mdb in motion_mdb.items() if mdb is not None}
+        work = (
+            None
+            if fusion.xhat is None
+            else fused_protection(used, self.fault_detectable, self.k2, detected)
+        )
+        protection: dict[str, float | None] = {"work": None if work is None else work[0]}
         xhat_covariance = _fused_covariance(measurements, fusion)
+        fault_x = 0.0 if work is None else work[1]
         events = []
         for m in measurements:
             watch = self.watch(m.name)
-            if m.name in verdict.withheld:
-                if xhat_covariance is not None and m.relative_m is not None:
-                    assert fusion.xhat is not None and m.sigma_relative_m2 is not None
-                    state.yhat[m.name] = fusion.xhat - m.relative_m
-                    watch.covariance = xhat_covariance + m.sigma_relative_m2
-                elif watch.covariance is not None:
-                    watch.covariance = watch.covariance + q2
-            elif m.fix_m is not None and m.sigma_gnss_m2 is not None:
-                watch.covariance = m.sigma_gnss_m2.copy()
-                if m.relative_m is not None and m.sigma_relative_m2 is not None:
-                    watch.covariance += m.sigma_relative_m2  # yhat mixes the fix and x - r
-            elif watch.covariance is not None:  # no fix: dead-reckoned by the fusion
-                watch.covariance = watch.covariance + q2
+            self._navigate(m, state, fusion, m.name in verdict.withheld, (xhat_covariance, fault_x))
+            protection[m.name] = watch.protection_m = (
+                None
+                if watch.covariance is None
+                else no_fault_radius(watch.covariance, self.k2) + watch.fault_m
+            )
             if watch.excluded and self._followed(watch, state.yhat[m.name]):
                 events.append(Event(m.name, "receiver"))
-        return events
+        return verdict.settled(events, protection)
+
+    def _navigate(
+        self,
+        m: SupportMeasurement,
+        state: StationState,
+        fusion: FusionResult,
+        withheld: bool,
+        work: tuple[np.ndarray | None, float],
+    ) -> None:
+        """The support's estimate where the monitor decides it (withheld and seeing the work
+        UAV: the formation's, ``work`` being xhat's covariance, None when blind, and its fault
+        term), its covariance, and the undetected bias it may carry."""
+        watch = self.watch(m.name)
+        xhat_covariance, fault_x = work
+        if withheld and xhat_covariance is not None and m.relative_m is not None:
+            assert fusion.xhat is not None and m.sigma_relative_m2 is not None
+            state.yhat[m.name] = fusion.xhat - m.relative_m
+            watch.covariance = xhat_covariance + m.sigma_relative_m2
+            watch.fault_m = fault_x
+        elif not withheld and m.fix_m is not None and m.sigma_gnss_m2 is not None:
+            watch.covariance = m.sigma_gnss_m2.copy()
+            if m.relative_m is not None and m.sigma_relative_m2 is not None:
+                watch.covariance += m.sigma_relative_m2  # yhat mixes the fix and x - r
+            own = watch.motion_detectable_m
+            if self.fault_detectable == 0.0:
+                watch.fault_m = 0.0  # a fault no likelier than the integrity risk
+            elif own is not None:
+                watch.fault_m = own * np.sqrt(self.fault_detectable / self.detectable)
+            else:
+                watch.fault_m = detectable_bias(2 * m.sigma_gnss_m2, self.fault_detectable)
+        elif watch.covariance is not None:  # dead-reckoned by the fusion: it drifts
+            watch.covariance = watch.covariance + self.motion_sigma_m**2 * np.eye(3)
 
     def _followed(self, watch: Watch, yhat: np.ndarray) -> bool:
         """Whether the bias has now followed the excluded support past receiver_travel_m."""
@@ -317,10 +371,25 @@ class IntegrityMonitor:
                     watch.taught.append(change)
         return updated
 
-    def extra_margin_m(self, name: str) -> float:
-        """How much further an excluded support keeps from everything (0 otherwise)."""
+    def extra_margin_m(self, name: str, allowance_m: float) -> float:
+        """How much further than the scenario's margins a support keeps from everything: its
+        protection radius beyond ``allowance_m`` (the margins' own allowance for an
+        estimate's error), and ``excluded_margin_m`` more while excluded."""
         watch = self.watches.get(name)
-        return self.settings.excluded_margin_m if watch is not None and watch.excluded else 0.0
+        if watch is None:
+            return 0.0
+        extra = max(0.0, (watch.protection_m or 0.0) - allowance_m)
+        return extra + (self.settings.excluded_margin_m if watch.excluded else 0.0)
+
+
+def fault_noncentrality(settings: IntegritySettings) -> float:
+    """lambda* of an undetected fault in the protection radii: the bias a test misses with
+    probability missed_detection / fault_prior; 0 where a fault is no likelier than the
+    integrity risk (then it does not widen a radius)."""
+    if settings.fault_prior <= settings.missed_detection:
+        return 0.0
+    allowed = min(0.5, settings.missed_detection / settings.fault_prior)
+    return detectable_noncentrality(settings.false_alarm, allowed)
 
 
 def _fused_covariance(

@@ -11,6 +11,8 @@ excluded or withheld. From the tlog's truth and the vehicles' events:
 - **time to detect**: from a fault's start to the first cycle at which its support was
   excluded (0 where it was excluded already); a fault during which its support was never
   excluded is a **missed detection**;
+- an **integrity event** is a cycle at which an estimate's true error (the work UAV's xhat,
+  or the estimate a support was sent) exceeded its protection radius;
 - a **false alarm** is an exclusion with no lying fault on that support and no zone bias at
   its true position; an exclusion in a zone (a real bias, if often below the test's minimal
   detectable bias in its worst direction) is a **zone exclusion**.
@@ -67,6 +69,7 @@ def integrity_metrics(
         "missed_detections": detection["missed"],
         "false_alarms": false_alarms,
         "zone_exclusions": in_zones,
+        "protection": protection_against_truth(trace, verdicts),
     }
 
 
@@ -134,3 +137,40 @@ def _unfaulted(
         in_zones += biased
         false_alarms += not biased
     return false_alarms, in_zones
+
+
+def protection_against_truth(
+    trace: RunTrace, verdicts: list[tuple[float, dict[str, Any]]]
+) -> dict[str, dict[str, Any]]:
+    """Per estimate (work, and the supports pooled): the protection radius's median and p95,
+    the true error's median, and the integrity events (error beyond the radius)."""
+    pairs: dict[str, list[tuple[float, float]]] = defaultdict(list)
+    for t, verdict in verdicts:
+        for name, radius in (verdict.get("protection_m") or {}).items():
+            if radius is None:
+                continue
+            error = _true_error(trace, name, t)
+            if error is not None:
+                pairs["work" if name == "work" else "supports"].append((radius, error))
+    found = {}
+    for group, values in sorted(pairs.items()):
+        radii, errors = np.array(values).T
+        found[group] = {
+            "radius_median_m": round(float(np.median(radii)), 3),
+            "radius_p95_m": round(float(np.percentile(radii, 95)), 3),
+            "error_median_m": round(float(np.median(errors)), 3),
+            "integrity_events": int(np.sum(errors > radii)),
+            "cycles": len(values),
+        }
+    return found
+
+
+def _true_error(trace: RunTrace, name: str, t: float) -> float | None:
+    """How far the estimate of ``name`` (work: xhat; a support: the estimate it was sent)
+    at cycle ``t`` was from its truth then (None where either is unknown)."""
+    system = VehicleIdentity.parse(name).system_id
+    estimate = trace.estimates.get(t) if system == 1 else trace.sent_estimates.get((system, t))
+    if estimate is None:
+        return None
+    truth, known = trace.truth_at(system, [t])
+    return float(np.linalg.norm(estimate - truth[0])) if known[0] else None

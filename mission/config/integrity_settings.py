@@ -23,7 +23,10 @@ class IntegritySettings:
     formation or dead reckoning, kept ``excluded_margin_m`` further from everything, and not
     teaching G a bias that follows it further than ``receiver_travel_m``. It is restored after
     ``recovery_cycles`` consistent cycles. ``missed_detection`` sets the minimal detectable
-    bias the docs and the protection radii quote. ``motion_sigma_m`` (kinematic points) and
+    bias the docs quote and is the protection radii's integrity risk: each estimate's error
+    stays within its radius but with that probability, a receiver starting to lie in a cycle
+    having probability ``fault_prior`` (its undetected bias counts only where that is the
+    larger). ``motion_sigma_m`` (kinematic points) and
     ``motion_sigma_multicopter_m`` are the spread, per axis and cycle, of where a vehicle ends
     against where it was commanded."""
 
@@ -36,9 +39,10 @@ class IntegritySettings:
     motion_sigma_multicopter_m: float
     excluded_margin_m: float
     receiver_travel_m: float
+    fault_prior: float
 
     def __post_init__(self) -> None:
-        for name in ("false_alarm", "missed_detection"):
+        for name in ("false_alarm", "missed_detection", "fault_prior"):
             value = getattr(self, name)
             _require(0 < value < 0.5, name, f"must be a probability in (0, 0.5), got {value}")
         for name in ("sustain_cycles", "recovery_cycles"):

@@ -174,7 +174,7 @@ def test_a_bias_that_follows_its_support_is_its_receivers_and_g_forgets_it(along
         verdict = monitor.check([support], state)
         if verdict.excluded:
             state.yhat["support-1"] = position  # placed by the formation
-            events = list(verdict.events) + monitor.settle([support], state, _blind(), verdict)
+            events = list(monitor.settle([support], state, _blind(), verdict).events)
             monitor.learn_excluded(g, [support], state.yhat, events)
         state.yhat["support-1"] = position
         state.last_support_command["support-1"] = np.array([1.0, 0.0, 0.0])
@@ -196,3 +196,30 @@ def test_an_excluded_supports_margins_are_wider_and_unused_slots_stay_unused():
     out = widened(np.array(normals + offsets), 1.0)
     np.testing.assert_allclose(out[:9], normals)
     np.testing.assert_allclose(out[9:], [1.75, -1.0, 1.75])
+
+
+def test_the_protection_radii_by_hand():
+    from ground_station.integrity.protection import (
+        detectable_bias,
+        fused_protection,
+        no_fault_radius,
+    )
+
+    covariance = np.diag([0.04, 0.01, 0.09])
+    k2 = gate(1e-3, 3)
+    assert no_fault_radius(covariance, k2) == pytest.approx(np.sqrt(k2 * 0.09))
+    lam = detectable_noncentrality(1e-5, 1e-3)
+    assert detectable_bias(covariance, lam) == pytest.approx(np.sqrt(lam * 0.09))
+    work = np.array([0.0, 0.0, 5.0])
+    supports = [
+        _support(f"support-{n}", [x, 6.0, 7.0], work - [x, 6.0, 7.0])
+        for n, x in ((1, -3.0), (2, 3.0))
+    ]
+    # two equal supports: P = Sigma / 2, each weighs 1/2; the other's MDB bounds each bias
+    sigma = SIGMA_GNSS + SIGMA_R
+    radius, fault = fused_protection(supports, lam, k2, {})
+    expected_fault = 0.5 * np.sqrt(lam * np.linalg.eigvalsh(sigma + sigma)[-1])
+    assert fault == pytest.approx(expected_fault, rel=1e-9)
+    assert radius == pytest.approx(no_fault_radius(sigma / 2, k2) + expected_fault, rel=1e-9)
+    # a fault no likelier than the risk: no fault term
+    assert fused_protection(supports, 0.0, k2, {})[1] == 0.0
