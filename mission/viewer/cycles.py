@@ -1,7 +1,8 @@
 """The rows of the ground station's control cycles (``records.jsonl``): the estimates, which
 supports were fused (S), each support's role, beta_n, each MPC's solve time and predicted
-path, the current waypoint; and, once the truth has reached a cycle's time, the work UAV's
-error and the steps each support has spent in a zone (counted as the metrics count them)."""
+path, the current waypoint, the integrity monitor's exclusions and protection radii; and,
+once the truth has reached a cycle's time, the work UAV's error and the steps each support
+has spent in a zone (counted as the metrics count them)."""
 
 from __future__ import annotations
 
@@ -61,6 +62,8 @@ class CycleRows:
                 if solve.get("path"):
                     path = np.array(solve["path"], dtype=float).reshape(-1, 3)
                     out.strips[f.mpc_path(name)].add(t, path, f.colour_of(name))
+            if "integrity" in record:
+                _integrity_rows(record, t, out)
             self._current_waypoint(int(record["k"]), t, out)
             self._pending.append((t, None if record.get("blind") else xhat))
 
@@ -99,3 +102,19 @@ class CycleRows:
             for t, hit in zip(times, inside):
                 self.zone_steps[name] += int(hit)
                 out.scalars[f.scalar_path("zone_steps", name)].add(t, self.zone_steps[name])
+
+
+def _integrity_rows(record: dict[str, Any], t: float, out: f.Frame) -> None:
+    """An excluded support's badge (a zero-sized one otherwise), and each estimate's
+    protection radius as a sphere around it."""
+    integrity = record["integrity"]
+    excluded = set(integrity.get("excluded", []))
+    positions = {"work": record["xhat"], **record.get("yhat", {})}
+    for name, yhat in record.get("yhat", {}).items():
+        badge = np.array(yhat, dtype=float) + f.EXCLUSION_BADGE_M
+        radius = f.EXCLUSION_RADIUS_M if name in excluded else 0.0
+        out.points[f.exclusion_path(name)].add(t, badge, f.EXCLUSION_COLOUR, radius)
+    for name, radius in integrity.get("protection_m", {}).items():
+        if radius is not None and name in positions:
+            centre = np.array(positions[name], dtype=float)
+            out.spheres[f.protection_path(name)].add(t, centre, f.colour_of(name), radius)

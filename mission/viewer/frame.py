@@ -47,6 +47,9 @@ ESTIMATE_RADIUS_M = 0.3
 FIX_RADIUS_M = 0.12
 ROLE_RADIUS_M = 0.2
 ROLE_BADGE_M = np.array([0.0, 0.0, 0.7])  # the role's badge, above a support's estimate
+EXCLUSION_COLOUR: Rgb = (255, 23, 68)  # a support the integrity monitor excluded
+EXCLUSION_BADGE_M = np.array([0.0, 0.0, -0.7])  # its badge, below the estimate
+EXCLUSION_RADIUS_M = 0.25
 
 
 def colour_of(name: str) -> Rgb:
@@ -94,6 +97,16 @@ def role_colour(name: str, role: str) -> Rgb:
     return ROLE_COLOURS.get(role, colour_of(name))
 
 
+def exclusion_path(name: str) -> str:
+    """A support the integrity monitor excluded: a badge below its estimate (none otherwise)."""
+    return f"integrity/{name}/excluded"
+
+
+def protection_path(name: str) -> str:
+    """An estimate's protection radius: a wire sphere around it."""
+    return f"integrity/{name}/protection"
+
+
 def current_waypoint_path(name: str) -> str:
     return f"plan/{name}/current"
 
@@ -120,12 +133,17 @@ class Rows:
     times: list[float] = field(default_factory=list)
     values: list[Any] = field(default_factory=list)
     colours: list[Rgb] = field(default_factory=list)
+    radii: list[float] = field(default_factory=list)  # per row, where an entity's vary
 
-    def add(self, time_s: float, value: Any, colour: Rgb | None = None) -> None:
+    def add(
+        self, time_s: float, value: Any, colour: Rgb | None = None, radius: float | None = None
+    ) -> None:
         self.times.append(time_s)
         self.values.append(value)
         if colour is not None:
             self.colours.append(colour)
+        if radius is not None:
+            self.radii.append(radius)
 
 
 @dataclass(frozen=True)
@@ -140,12 +158,13 @@ class VoxelRow:
 @dataclass
 class Frame:
     """New rows since the last frame: points (one position each), strips (one polyline each),
-    scalars, and G's snapshots."""
+    spheres (a centre and a radius each, drawn as wire), scalars, and G's snapshots."""
 
     points: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
     strips: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
+    spheres: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
     scalars: dict[str, Rows] = field(default_factory=lambda: defaultdict(Rows))
     voxels: list[VoxelRow] = field(default_factory=list)
 
     def __bool__(self) -> bool:
-        return bool(self.points or self.strips or self.scalars or self.voxels)
+        return bool(self.points or self.strips or self.spheres or self.scalars or self.voxels)

@@ -111,10 +111,20 @@ def send_frame(rec: rr.RecordingStream, frame: f.Frame, scene: Scene) -> None:
     """A frame's rows, entity by entity."""
     for path, rows in frame.points.items():
         radius = _POINT_RADII.get(path.split("/", 1)[0], 0.3)
+        radii = rows.radii or [radius] * len(rows.times)
         columns = rr.Points3D.columns(
             positions=np.array(rows.values, dtype=float).reshape(-1, 3),
             colors=np.array(rows.colours, dtype=np.uint8).reshape(-1, 3),
-            radii=np.full(len(rows.times), radius, dtype=np.float32),
+            radii=np.array(radii, dtype=np.float32),
+        ).partition(np.ones(len(rows.times), dtype=np.int32))
+        _send(rec, path, rows.times, columns)
+    for path, rows in frame.spheres.items():
+        half = np.repeat(np.array(rows.radii, dtype=np.float32)[:, None], 3, axis=1)
+        columns = rr.Ellipsoids3D.columns(
+            centers=np.array(rows.values, dtype=float).reshape(-1, 3),
+            half_sizes=half,
+            colors=np.array(rows.colours, dtype=np.uint8).reshape(-1, 3),
+            fill_mode=[rr.components.FillMode.MajorWireframe] * len(rows.times),
         ).partition(np.ones(len(rows.times), dtype=np.int32))
         _send(rec, path, rows.times, columns)
     for path, rows in frame.strips.items():

@@ -1,16 +1,19 @@
 """The integrity monitor in a real run: a support whose receiver glitches 2.2 m is excluded
 within a cycle of the glitch, said so in a STATUSTEXT (chunked where long) in the tlog, and
-restored once the glitch is over; the summary counts it from the truth."""
+restored once the glitch is over; the summary counts it from the truth; the 3-D view marks
+the excluded support and draws each estimate's protection radius."""
 
 from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 from pymavlink import mavutil
 
 from mission.link.statustext import StatusChunks
 from tests.processes import mission
+from tests.viewer.rrd import read_rrd
 
 pytestmark = pytest.mark.slow  # starts a run
 
@@ -34,11 +37,19 @@ def _station_texts(tlog) -> list[tuple[float, str]]:
     return said
 
 
-def test_a_glitched_support_is_excluded_at_once_and_restored_after(tmp_path):
+@pytest.fixture(scope="module")
+def glitched(tmp_path_factory):
+    """The glitched run's folder."""
+    tmp_path = tmp_path_factory.mktemp("glitched")
     scenario = tmp_path / "glitched.yaml"
     scenario.write_text(GLITCHED)
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
     assert result.returncode == 0, result.stderr
+    return tmp_path
+
+
+def test_a_glitched_support_is_excluded_at_once_and_restored_after(glitched):
+    tmp_path = glitched
     texts = [text for _, text in _station_texts(tmp_path / "run" / "gcs.tlog")]
     excluded = [t for t in texts if t.startswith("Integrity: support-3 excluded (")]
     assert excluded and "test, 2." in excluded[0]  # the 2.2 m glitch, seen as such
@@ -52,3 +63,18 @@ def test_a_glitched_support_is_excluded_at_once_and_restored_after(tmp_path):
     assert integrity["time_to_detect_s"][0] <= 0.5
     assert integrity["false_alarms"] == 0
     assert summary["safety"]["contacts"] == []
+
+
+def test_the_view_marks_the_excluded_support_and_draws_every_protection_radius(glitched):
+    run = glitched / "run"
+    recording = glitched / "run.rrd"
+    assert mission("view", str(run), "--save", str(recording)).returncode == 0
+    rows = read_rrd(recording)
+    records = [json.loads(line) for line in (run / "records.jsonl").open()]
+    badge = rows["/integrity/support-3/excluded"]["Points3D:radii"]
+    shown = [row[0] > 0 for row in badge]
+    assert shown == ["support-3" in r["integrity"]["excluded"] for r in records]
+    assert any(shown)
+    spheres = rows["/integrity/work/protection"]["Ellipsoids3D:half_sizes"]
+    radii = [r["integrity"]["protection_m"]["work"] for r in records]
+    assert np.allclose([row[0][0] for row in spheres], [x for x in radii if x is not None])
