@@ -14,24 +14,25 @@ statistic T = nu^T S^-1 nu of a 3-vector innovation nu with its covariance S.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ground_station.fusion import SupportMeasurement
+from ground_station.integrity.small import inverse3, quadratic3
 
 
 @dataclass(frozen=True)
 class Innovation:
-    """nu, its covariance S, and T = nu^T S^-1 nu."""
+    """nu, its covariance S, and T = nu^T S^-1 nu (computed once)."""
 
     nu: np.ndarray
     covariance: np.ndarray
+    statistic: float = field(init=False)  # chi-square with 3 degrees of freedom, no fault
 
-    @property
-    def statistic(self) -> float:
-        """T, chi-square with 3 degrees of freedom without a fault."""
-        return float(self.nu @ np.linalg.solve(self.covariance, self.nu))
+    def __post_init__(self) -> None:
+        value = quadratic3(self.nu, inverse3(self.covariance))
+        object.__setattr__(self, "statistic", value)
 
     @property
     def size_m(self) -> float:
@@ -50,36 +51,55 @@ def motion_innovation(
     if support.fix_m is None or support.sigma_gnss_m2 is None:
         return None
     expected = previous_yhat + moved
-    covariance = support.sigma_gnss_m2 + previous_covariance + motion_sigma_m**2 * np.eye(3)
+    covariance = support.sigma_gnss_m2 + previous_covariance
+    covariance[np.diag_indices(3)] += motion_sigma_m**2
     return Innovation(support.fix_m - expected, covariance)
+
+
+class Formation:
+    """The contributing supports' information (Sigma_n^-1 and Sigma_n^-1 mu_n), computed once
+    a cycle, for estimates of the work UAV from any subset of them."""
+
+    def __init__(self, measurements: Sequence[SupportMeasurement]) -> None:
+        self.members = {m.name: m for m in measurements if m.contributes}
+        self.information = {name: inverse3(m.sigma) for name, m in self.members.items()}
+        self.weighted = {name: self.information[name] @ m.mu for name, m in self.members.items()}
+
+    def estimate(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray] | None:
+        """The work UAV's position from ``names`` (contributing supports), information-weighted,
+        and its covariance (None with none)."""
+        names = [name for name in names if name in self.members]
+        if not names:
+            return None
+        information = sum(self.information[name] for name in names)
+        covariance = inverse3(information)
+        return covariance @ sum(self.weighted[name] for name in names), covariance
+
+    def innovation(self, name: str, others: Sequence[str]) -> Innovation | None:
+        """The formation test's innovation of ``name`` against ``others`` (None where it or no
+        other contributes)."""
+        support = self.members.get(name)
+        if support is None:
+            return None
+        found = self.estimate([other for other in others if other != name])
+        if found is None:
+            return None
+        position, covariance = found
+        return Innovation(support.mu - position, support.sigma + covariance)
 
 
 def formation_estimate(
     others: Sequence[SupportMeasurement],
 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """The work UAV's position from the given contributing supports, information-weighted,
-    and its covariance (None with none)."""
-    usable = [m for m in others if m.contributes]
-    if not usable:
-        return None
-    information = np.zeros((3, 3))
-    weighted = np.zeros(3)
-    for m in usable:
-        inverse = np.linalg.inv(m.sigma)
-        information += inverse
-        weighted += inverse @ m.mu
-    covariance = np.linalg.inv(information)
-    return covariance @ weighted, covariance
+    """The work UAV's position from the given supports, information-weighted, and its
+    covariance (None with none contributing)."""
+    formation = Formation(others)
+    return formation.estimate(list(formation.members))
 
 
 def formation_innovation(
     support: SupportMeasurement, others: Sequence[SupportMeasurement]
 ) -> Innovation | None:
     """The formation test's innovation (None where the support or no other contributes)."""
-    if not support.contributes:
-        return None
-    estimate = formation_estimate([m for m in others if m.name != support.name])
-    if estimate is None:
-        return None
-    position, covariance = estimate
-    return Innovation(support.mu - position, support.sigma + covariance)
+    formation = Formation([support, *(m for m in others if m.name != support.name)])
+    return formation.innovation(support.name, list(formation.members))

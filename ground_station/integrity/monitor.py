@@ -23,109 +23,23 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ground_station.fusion import FusionResult, SupportMeasurement
-from ground_station.gnss_map import Change, LocalizabilityMap
+from ground_station.gnss_map import LocalizabilityMap
+from ground_station.integrity.aftermath import learn_excluded, settle
 from ground_station.integrity.chi_square import detectable_noncentrality, gate
-from ground_station.integrity.consistency import (
-    Innovation,
-    formation_innovation,
-    motion_innovation,
-)
+from ground_station.integrity.consistency import Formation, Innovation, motion_innovation
 from ground_station.integrity.protection import (
     detectable_bias,
-    fused_protection,
-    no_fault_radius,
 )
+from ground_station.integrity.verdict import Event, Verdict, Watch
 from ground_station.state import StationState
 from mission.config.integrity_settings import IntegritySettings
 
 SUSPECT_EXPONENT = 0.5  # the suspect gate's false-alarm rate is false_alarm ** this
 TESTS = ("motion", "formation")
-
-
-@dataclass
-class Watch:
-    """What the monitor carries for one support between cycles."""
-
-    covariance: np.ndarray | None = None  # of its estimate, for the motion test
-    excluded: bool = False
-    recent: dict[str, deque[float]] = field(default_factory=dict)  # each test's statistics
-    consistent: int = 0  # cycles in a row under the suspect gate, while excluded
-    since: np.ndarray | None = None  # its estimate where it was excluded
-    travel_m: float = 0.0  # how far its estimate went from there while excluded
-    receiver: bool = False  # the bias followed it: its receiver's, not a place's
-    taught: list[Change] = field(default_factory=list)  # what it taught G while excluded
-    motion_detectable_m: float | None = None  # its motion test's MDB this cycle
-    fault_m: float = 0.0  # the undetected bias its estimate may carry (protection radius)
-    protection_m: float | None = None  # its estimate's protection radius
-
-
-@dataclass(frozen=True)
-class Event:
-    """An exclusion, a restoration, or a bias found to follow a support (its receiver's)."""
-
-    support: str
-    kind: str  # excluded, restored, receiver
-    test: str = ""
-    size_m: float = 0.0  # |nu| of the test that excluded it
-    detectable_m: float = 0.0  # that test's minimal detectable bias (its worst direction)
-
-    def record(self) -> dict:
-        """What records.jsonl keeps of it."""
-        found = {"support": self.support, "kind": self.kind}
-        if self.kind == "excluded":
-            found.update(
-                test=self.test, size_m=round(self.size_m, 3), mdb_m=round(self.detectable_m, 3)
-            )
-        return found
-
-    @property
-    def text(self) -> str:
-        """The STATUSTEXT the ground station sends."""
-        if self.kind == "excluded":
-            return f"Integrity: {self.support} excluded ({self.test} test, {self.size_m:.1f} m)"
-        if self.kind == "receiver":
-            return f"Integrity: {self.support} receiver at fault"
-        return f"Integrity: {self.support} restored"
-
-
-@dataclass(frozen=True)
-class Verdict:
-    """One cycle's outcome: each support's statistics, who is excluded, who is withheld from
-    the fusion this cycle (the excluded, the suspect, the ambiguous), and what changed."""
-
-    statistics: dict[str, dict[str, float]]
-    excluded: frozenset[str]
-    withheld: frozenset[str]
-    ambiguous: tuple[str, ...]
-    events: tuple[Event, ...]
-    protection_m: dict[str, float | None] = field(default_factory=dict)  # work and supports
-
-    def settled(self, found: Sequence[Event], protection: dict[str, float | None]) -> Verdict:
-        """The verdict with what the cycle found after the fusion, and the estimates'
-        protection radii."""
-        return replace(self, events=self.events + tuple(found), protection_m=protection)
-
-    def record(self) -> dict:
-        """What records.jsonl keeps of it."""
-        return {
-            "statistics": {
-                name: {test: round(value, 3) for test, value in tests.items()}
-                for name, tests in self.statistics.items()
-            },
-            "excluded": sorted(self.excluded),
-            "withheld": sorted(self.withheld),
-            "ambiguous": list(self.ambiguous),
-            "events": [event.record() for event in self.events],
-            "protection_m": {
-                name: None if radius is None else round(radius, 3)
-                for name, radius in self.protection_m.items()
-            },
-        }
 
 
 class IntegrityMonitor:
@@ -145,6 +59,7 @@ class IntegrityMonitor:
         self.k2 = gate(settings.missed_detection, 3)  # the no-fault radius's quantile
         self.fault_detectable = fault_noncentrality(settings)
         self.watches: dict[str, Watch] = {}
+        self.formation = Formation([])  # the cycle's supports' information (check, then settle)
 
     def watch(self, name: str) -> Watch:
         """The support's watch (made at its first cycle)."""
@@ -193,7 +108,7 @@ class IntegrityMonitor:
             return None
         moved = state.last_support_command.get(support.name, np.zeros(3))
         found = motion_innovation(support, previous, moved, watch.covariance, self.motion_sigma_m)
-        if found is not None:
+        if found is not None and self.fault_detectable > 0:  # its bias widens the radii
             watch.motion_detectable_m = detectable_bias(found.covariance, self.detectable)
         return found
 
@@ -203,21 +118,22 @@ class IntegrityMonitor:
         """Each contributing support's formation innovation against the trusted others, with
         the liar identified where the others exceed too; and the supports it cannot tell
         apart."""
-        contributing = [m for m in measurements if m.contributes]
+        formation = self.formation = Formation(measurements)  # settle reuses it
+        contributing = list(formation.members)
         trusted = [
-            m
-            for m in contributing
-            if not self.watch(m.name).excluded and m.name not in suspect_motion
+            name
+            for name in contributing
+            if not self.watch(name).excluded and name not in suspect_motion
         ]
-        found = {m.name: formation_innovation(m, trusted) for m in contributing}
+        found = {name: formation.innovation(name, trusted) for name in contributing}
         found = {name: f for name, f in found.items() if f is not None}
-        over = [m.name for m in trusted if m.name in found and self._over(found[m.name])]
+        over = [name for name in trusted if name in found and self._over(found[name])]
         if not over:
             return found, []
         if len(trusted) >= 3:
             blamed = max(over, key=lambda name: found[name].statistic)
-            rest = [m for m in trusted if m.name != blamed]
-            again = {m.name: formation_innovation(m, rest) for m in rest}
+            rest = [name for name in trusted if name != blamed]
+            again = {name: formation.innovation(name, rest) for name in rest}
             if not any(f is not None and self._over(f) for f in again.values()):
                 found.update({name: f for name, f in again.items() if f is not None})
                 return found, []
@@ -272,77 +188,9 @@ class IntegrityMonitor:
         fusion: FusionResult,
         verdict: Verdict,
     ) -> Verdict:
-        """After the fusion (which had no fix of the withheld supports, so dead-reckoned
-        them): a withheld support that sees the work UAV is placed by the formation instead
-        (xhat - r_n); each estimate's covariance and protection radius; how far an excluded
-        support has gone, and, past ``receiver_travel_m``, its bias called its receiver's.
-        Returns the verdict with those findings and radii."""
-        used = [m for m in measurements if m.name in fusion.consistent and m.contributes]
-        scale = np.sqrt(self.fault_detectable / self.detectable)  # MDB at the fault's rate
-        motion_mdb = {m.name: self.watch(m.name).motion_detectable_m for m in used}
-        detected = {name: mdb * scale for name, mdb in motion_mdb.items() if mdb is not None}
-        work = (
-            None
-            if fusion.xhat is None
-            else fused_protection(used, self.fault_detectable, self.k2, detected)
-        )
-        protection: dict[str, float | None] = {"work": None if work is None else work[0]}
-        xhat_covariance = _fused_covariance(measurements, fusion)
-        fault_x = 0.0 if work is None else work[1]
-        events = []
-        for m in measurements:
-            watch = self.watch(m.name)
-            self._navigate(m, state, fusion, m.name in verdict.withheld, (xhat_covariance, fault_x))
-            protection[m.name] = watch.protection_m = (
-                None
-                if watch.covariance is None
-                else no_fault_radius(watch.covariance, self.k2) + watch.fault_m
-            )
-            if watch.excluded and self._followed(watch, state.yhat[m.name]):
-                events.append(Event(m.name, "receiver"))
-        return verdict.settled(events, protection)
-
-    def _navigate(
-        self,
-        m: SupportMeasurement,
-        state: StationState,
-        fusion: FusionResult,
-        withheld: bool,
-        work: tuple[np.ndarray | None, float],
-    ) -> None:
-        """The support's estimate where the monitor decides it (withheld and seeing the work
-        UAV: the formation's, ``work`` being xhat's covariance, None when blind, and its fault
-        term), its covariance, and the undetected bias it may carry."""
-        watch = self.watch(m.name)
-        xhat_covariance, fault_x = work
-        if withheld and xhat_covariance is not None and m.relative_m is not None:
-            assert fusion.xhat is not None and m.sigma_relative_m2 is not None
-            state.yhat[m.name] = fusion.xhat - m.relative_m
-            watch.covariance = xhat_covariance + m.sigma_relative_m2
-            watch.fault_m = fault_x
-        elif not withheld and m.fix_m is not None and m.sigma_gnss_m2 is not None:
-            watch.covariance = m.sigma_gnss_m2.copy()
-            if m.relative_m is not None and m.sigma_relative_m2 is not None:
-                watch.covariance += m.sigma_relative_m2  # yhat mixes the fix and x - r
-            own = watch.motion_detectable_m
-            if self.fault_detectable == 0.0:
-                watch.fault_m = 0.0  # a fault no likelier than the integrity risk
-            elif own is not None:
-                watch.fault_m = own * np.sqrt(self.fault_detectable / self.detectable)
-            else:
-                watch.fault_m = detectable_bias(2 * m.sigma_gnss_m2, self.fault_detectable)
-        elif watch.covariance is not None:  # dead-reckoned by the fusion: it drifts
-            watch.covariance = watch.covariance + self.motion_sigma_m**2 * np.eye(3)
-
-    def _followed(self, watch: Watch, yhat: np.ndarray) -> bool:
-        """Whether the bias has now followed the excluded support past receiver_travel_m."""
-        if watch.since is None:
-            watch.since = np.array(yhat, dtype=float)
-        watch.travel_m = max(watch.travel_m, float(np.linalg.norm(yhat - watch.since)))
-        if watch.receiver or watch.travel_m <= self.settings.receiver_travel_m:
-            return False
-        watch.receiver = True
-        return True
+        """After the fusion: the withheld supports' navigation, each estimate's covariance and
+        protection radius, the receiver calls (:func:`~.aftermath.settle`)."""
+        return settle(self, measurements, state, fusion, verdict)
 
     def learn_excluded(
         self,
@@ -351,25 +199,9 @@ class IntegrityMonitor:
         yhat: dict[str, np.ndarray],
         events: Sequence[Event],
     ) -> int:
-        """G from the excluded supports that see the work UAV, recorded so that it can be
-        taken back: an excluded support's bias is a place's (a zone) until it has followed the
-        support, then it is the receiver's and what it taught G is taken back (and it teaches
-        nothing more until restored). Returns how many voxel updates were made."""
-        for event in events:
-            watch = self.watch(event.support)
-            if event.kind == "receiver":
-                g.take_back(watch.taught)
-                watch.taught = []
-        updated = 0
-        for m in measurements:
-            watch = self.watch(m.name)
-            if watch.excluded and not watch.receiver and m.contributes:
-                assert m.fix_m is not None
-                count, change = g.update_recorded(m.fix_m, yhat[m.name])
-                updated += count
-                if change is not None:
-                    watch.taught.append(change)
-        return updated
+        """What the excluded supports teach G, and what a receiver's taught taken back
+        (:func:`~.aftermath.learn_excluded`)."""
+        return learn_excluded(self, g, measurements, yhat, events)
 
     def extra_margin_m(self, name: str, allowance_m: float) -> float:
         """How much further than the scenario's margins a support keeps from everything: its
@@ -390,16 +222,3 @@ def fault_noncentrality(settings: IntegritySettings) -> float:
         return 0.0
     allowed = min(0.5, settings.missed_detection / settings.fault_prior)
     return detectable_noncentrality(settings.false_alarm, allowed)
-
-
-def _fused_covariance(
-    measurements: Sequence[SupportMeasurement], fusion: FusionResult
-) -> np.ndarray | None:
-    """xhat's covariance from the supports in S (information-summed), or None when blind."""
-    if fusion.xhat is None:
-        return None
-    used = [m for m in measurements if m.name in fusion.consistent and m.contributes]
-    if not used:
-        return None
-    information = sum(np.linalg.inv(m.sigma) for m in used)
-    return np.linalg.inv(information)

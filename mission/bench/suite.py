@@ -17,6 +17,7 @@ from typing import Any, TextIO
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.bench.floor import RUN_CPU_TARGET_S, bench_floor
+from mission.bench.integrity import bench_integrity
 from mission.bench.margins import bench_margins
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
@@ -339,8 +340,8 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
 def run_as_command(
     scenario: str, method: str, out: Path, mpc_helper: bool | None = None
 ) -> dict[str, Any]:
-    """The summary of ``python -m mission run SCENARIO --method METHOD --seed 0 --out OUT``
-    (a fresh process: this one may have threads that keep it from forking vehicles)."""
+    """The summary of ``mission run SCENARIO --method METHOD --seed 0 --out OUT``, a fresh
+    process (this one may have threads that keep it from forking vehicles)."""
     import json
 
     command = mission_run_argv(scenario, out, method, 0, mpc_helper, ["--exit-with-parent"])
@@ -354,6 +355,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "gcs": bench_ground_station,
     "margins": bench_margins,
     "roles": bench_roles,
+    "integrity": bench_integrity,
     "run": bench_runs,
     "floor": bench_floor,
     "study": bench_studies,
@@ -382,18 +384,3 @@ def run_benchmarks(
             results.extend(bench())
             progress.write(f"bench: {name} done in {time.monotonic() - start:.0f} s\n")
     return results
-
-
-def format_table(results: list[BenchResult]) -> str:
-    """A plain-text table of results."""
-    width = max([len("benchmark"), *(len(r.name) for r in results)])
-    lines = [f"{'benchmark':<{width}} {'value':>12} {'unit':<8} {'target':<10} ok"]
-    lines += [
-        f"{r.name:<{width}} {r.value:>12.4g} {r.unit:<8} {r.target:<10} {_verdict(r.ok)}"
-        for r in results
-    ]
-    return "\n".join(lines)
-
-
-def _verdict(ok: bool | None) -> str:
-    return "-" if ok is None else "yes" if ok else "NO"

@@ -13,7 +13,18 @@ def add_parser(commands) -> None:
     parser.add_argument(
         "--only",
         action="append",
-        choices=["world", "vehicle", "gcs", "margins", "roles", "run", "floor", "study", "view"],
+        choices=[
+            "world",
+            "vehicle",
+            "gcs",
+            "margins",
+            "roles",
+            "integrity",
+            "run",
+            "floor",
+            "study",
+            "view",
+        ],
         help="run only this group (repeatable)",
     )
     parser.set_defaults(handler=bench)
@@ -21,7 +32,8 @@ def add_parser(commands) -> None:
 
 def bench(args: argparse.Namespace) -> int:
     """``mission bench``."""
-    from mission.bench.suite import format_table, run_benchmarks
+    from mission.bench.result import format_table
+    from mission.bench.suite import run_benchmarks
     from mission.procs.interrupts import StopRequest
 
     with StopRequest():  # Ctrl-C stops it even where it was started as a background job

@@ -11,6 +11,7 @@ from types import SimpleNamespace
 import pytest
 
 from mission.bench import suite as bench
+from mission.bench.result import format_table
 
 
 @dataclass
@@ -107,7 +108,7 @@ def test_every_invocation_starts_with_the_machines_speed_without_a_verdict(monke
     rows = bench.run_benchmarks(["world"])
     assert [r.name for r in rows] == ["machine_python_loop_s", "x"]
     assert rows[0].ok is None and 0 < rows[0].value < 60
-    table = bench.format_table(rows).splitlines()
+    table = format_table(rows).splitlines()
     assert table[1].split()[-2:] == ["reference", "-"]
     assert table[2].split()[-1] == "yes"
 
@@ -182,6 +183,25 @@ def test_the_roles_row_is_the_median_of_the_paired_runs_ratios(monkeypatch):
     assert longest.value == 40.0 and longest.ok is None
     assert order[:4] == ["fixed", "dynamic", "fixed", "dynamic"]
     assert order[6:10] == ["dynamic", "fixed", "dynamic", "fixed"]
+
+
+def test_the_integrity_row_pairs_runs_with_the_monitor_on_and_off(monkeypatch):
+    """As the roles row: medians off 10, 10, 10 and on 10.2, 11, 10.4: ratios 1.02, 1.1,
+    1.04, their median 1.04, under the target."""
+    from mission.bench import detached, integrity
+
+    off = iter([[10.0, 10.0, 10.0]] * 3)
+    on = iter([[10.2, 10.2, 9.0], [11.0, 11.0, 11.0], [10.4, 10.4, 10.4]])
+
+    def fake(world, waypoints, adaptive, seed, max_cycles):
+        times = next(on if world.scenario.integrity.enabled else off)
+        for t in times:
+            yield SimpleNamespace(cycle_ms=t), None, False
+
+    monkeypatch.setattr(detached, "detached_cycles", fake)
+    (ratio,) = integrity.bench_integrity(cycles=3, repeats=3)
+    assert ratio.name == "integrity_cycle_ratio" and ratio.value == pytest.approx(1.04)
+    assert ratio.ok is True
 
 
 def test_the_floor_rows_are_the_detached_runs_cpu_and_plan_seconds(monkeypatch):

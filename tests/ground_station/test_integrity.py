@@ -223,3 +223,17 @@ def test_the_protection_radii_by_hand():
     assert radius == pytest.approx(no_fault_radius(sigma / 2, k2) + expected_fault, rel=1e-9)
     # a fault no likelier than the risk: no fault term
     assert fused_protection(supports, 0.0, k2, {})[1] == 0.0
+
+
+def test_the_plain_float_inverse_and_quadratic_are_numpys():
+    from ground_station.integrity.small import inverse3, quadratic3
+
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        half = rng.normal(size=(3, 3))
+        matrix = half @ half.T + 0.01 * np.eye(3)
+        np.testing.assert_allclose(inverse3(matrix), np.linalg.inv(matrix), rtol=1e-9, atol=1e-9)
+        v = rng.normal(size=3)
+        assert quadratic3(v, inverse3(matrix)) == pytest.approx(v @ np.linalg.solve(matrix, v))
+    with pytest.raises(ValueError, match="singular"):
+        inverse3(np.zeros((3, 3)))
