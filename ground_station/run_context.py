@@ -83,7 +83,8 @@ def _monitor(scenario: Scenario) -> IntegrityMonitor | None:
     """The integrity monitor where the scenario has it on."""
     if not scenario.integrity.enabled:
         return None
-    return IntegrityMonitor(scenario.integrity, scenario.vehicle.dynamics == "multicopter")
+    multicopter = scenario.vehicle.dynamics == "multicopter"
+    return IntegrityMonitor(scenario.integrity, multicopter, scenario.map.voxel_size_m)
 
 
 def require_known_world(world: KnownWorld) -> KnownWorld:

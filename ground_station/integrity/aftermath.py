@@ -157,13 +157,15 @@ def learn_excluded(
     events: Sequence[Event],
 ) -> int:
     """G from the excluded supports that see the work UAV, recorded so that it can be taken
-    back: an excluded support's bias is a place's (a zone) until it has followed the support,
-    then it is the receiver's and what it taught G is taken back (and it teaches nothing more
-    until restored). Returns how many voxel updates were made."""
-    for event in events:
+    back: an excluded support's bias is a place's (a zone) until it has followed the support
+    past ``receiver_travel_m``, or gone while the support stayed in its voxel; then it was the
+    receiver's and what it taught G is taken back (and it teaches nothing more until
+    restored). Returns how many voxel updates were made."""
+    for event in events:  # a receiver's teaching taken back, a place's kept once restored
         watch = monitor.watch(event.support)
         if event.kind == "receiver":
             g.take_back(watch.taught)
+        if event.kind in ("receiver", "restored"):
             watch.taught = []
     updated = 0
     for m in measurements:

@@ -46,8 +46,9 @@ class IntegrityMonitor:
     """Tests every support's fix each cycle (:meth:`check`) and keeps each one's covariance
     and state (:meth:`settle`, after the fusion)."""
 
-    def __init__(self, settings: IntegritySettings, multicopter: bool) -> None:
+    def __init__(self, settings: IntegritySettings, multicopter: bool, voxel_m: float) -> None:
         self.settings = settings
+        self.voxel_m = voxel_m  # G's resolution: a place finer than this is one place
         self.motion_sigma_m = (
             settings.motion_sigma_multicopter_m if multicopter else settings.motion_sigma_m
         )
@@ -77,17 +78,16 @@ class IntegrityMonitor:
         suspect_motion = {
             n for n, found in motion.items() if found and found.statistic > self.suspect_gate
         }
-        formation, ambiguous = self._formation(measurements, suspect_motion)
+        recorded, decisive, ambiguous = self._formation(measurements, suspect_motion)
         statistics: dict[str, dict[str, float]] = {}
         events: list[Event] = []
         withheld = set(ambiguous)
         for m in measurements:
-            found = {"motion": motion[m.name], "formation": formation.get(m.name)}
+            shown = {"motion": motion[m.name], "formation": recorded.get(m.name)}
+            statistics[m.name] = {test: f.statistic for test, f in shown.items() if f is not None}
+            found = {"motion": motion[m.name], "formation": decisive.get(m.name)}
             present = {test: f for test, f in found.items() if f is not None}
-            statistics[m.name] = {test: f.statistic for test, f in present.items()}
-            event = self._step(m.name, present)
-            if event is not None:
-                events.append(event)
+            events += self._step(m.name, present, state.yhat.get(m.name))
             watch = self.watch(m.name)
             if watch.excluded or any(f.statistic > self.suspect_gate for f in present.values()):
                 withheld.add(m.name)
@@ -114,10 +114,12 @@ class IntegrityMonitor:
 
     def _formation(
         self, measurements: Sequence[SupportMeasurement], suspect_motion: set[str]
-    ) -> tuple[dict[str, Innovation], list[str]]:
-        """Each contributing support's formation innovation against the trusted others, with
-        the liar identified where the others exceed too; and the supports it cannot tell
-        apart."""
+    ) -> tuple[dict[str, Innovation], dict[str, Innovation], list[str]]:
+        """Each contributing support's formation innovation against the trusted others (all of
+        them, for the record), those that speak of the support itself (decisive), and the
+        supports it cannot tell apart. A support not trusted is judged against the trusted;
+        with three or more trusted, where several exceed, the largest is blamed if the others
+        then agree; two trusted test only each other, a pair that cannot say which lies."""
         formation = self.formation = Formation(measurements)  # settle reuses it
         contributing = list(formation.members)
         trusted = [
@@ -127,23 +129,29 @@ class IntegrityMonitor:
         ]
         found = {name: formation.innovation(name, trusted) for name in contributing}
         found = {name: f for name, f in found.items() if f is not None}
+        decisive = {name: f for name, f in found.items() if name not in trusted}
         over = [name for name in trusted if name in found and self._over(found[name])]
-        if not over:
-            return found, []
-        if len(trusted) >= 3:
+        if len(trusted) < 3:
+            return found, decisive, over if len(over) > 1 else []
+        if over:
             blamed = max(over, key=lambda name: found[name].statistic)
             rest = [name for name in trusted if name != blamed]
             again = {name: formation.innovation(name, rest) for name in rest}
-            if not any(f is not None and self._over(f) for f in again.values()):
-                found.update({name: f for name, f in again.items() if f is not None})
-                return found, []
-        return {n: f for n, f in found.items() if n not in over}, over
+            if any(f is not None and self._over(f) for f in again.values()):
+                return found, decisive, over
+            decisive[blamed] = found[blamed]
+            decisive.update({name: f for name, f in again.items() if f is not None})
+            return found, decisive, []
+        decisive.update({name: found[name] for name in trusted if name in found})
+        return found, decisive, []
 
     def _over(self, innovation: Innovation) -> bool:
         return innovation.statistic > self.gates[0]
 
-    def _step(self, name: str, present: dict[str, Innovation]) -> Event | None:
-        """The support's state machine, one cycle on."""
+    def _step(
+        self, name: str, present: dict[str, Innovation], position: np.ndarray | None
+    ) -> list[Event]:
+        """The support's state machine, one cycle on (``position``: its last estimate)."""
         watch = self.watch(name)
         for test in TESTS:
             recent = watch.recent.setdefault(test, deque(maxlen=len(self.gates)))
@@ -154,20 +162,44 @@ class IntegrityMonitor:
         if not watch.excluded:
             test = self._exceeded(watch)
             if test is None:
-                return None
+                return []
             watch.excluded, watch.consistent, watch.travel_m = True, 0, 0.0
             watch.since, watch.receiver, watch.taught = None, False, []
+            watch.biased_at = watch.quiet_at = position
+            watch.biased_cycles = 1
             found = present[test]
             detectable_m = detectable_bias(found.covariance, self.detectable)
-            return Event(name, "excluded", test, found.size_m, detectable_m)
+            return [Event(name, "excluded", test, found.size_m, detectable_m)]
         quiet = bool(present) and all(f.statistic <= self.suspect_gate for f in present.values())
-        watch.consistent = watch.consistent + 1 if quiet else 0
+        if not quiet:
+            watch.consistent, watch.biased_at = 0, position
+            watch.biased_cycles += 1
+            return []
+        watch.consistent += 1
+        if watch.consistent == 1:
+            watch.quiet_at = position  # where the bias was first gone
         if watch.consistent < self.settings.recovery_cycles:
-            return None
-        watch.excluded, watch.consistent, watch.taught = False, 0, []  # what it taught stays
+            return []
+        watch.excluded, watch.consistent = False, 0
         for recent in watch.recent.values():
             recent.clear()
-        return Event(name, "restored")
+        found = [Event(name, "restored")]
+        if not watch.receiver and self._vanished_in_place(watch):
+            watch.receiver = True
+            found.insert(0, Event(name, "receiver"))
+        return found
+
+    def _vanished_in_place(self, watch: Watch) -> bool:
+        """Whether a bias that lasted recovery_cycles went while the support stayed in the
+        voxel where it was last seen: a place's bias stays with the place, a receiver's can
+        end anywhere. (A shorter one, or one gone as the support moved, may have been a
+        support dipping into a zone's face: that is kept as the place's.)"""
+        if watch.biased_at is None or watch.quiet_at is None:
+            return False
+        if watch.biased_cycles < self.settings.recovery_cycles:
+            return False
+        moved = float(np.linalg.norm(np.asarray(watch.quiet_at) - watch.biased_at))
+        return moved < self.voxel_m
 
     def _exceeded(self, watch: Watch) -> str | None:
         """The test whose statistics over the last m cycles exceed their gate (the largest

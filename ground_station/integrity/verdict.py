@@ -25,6 +25,9 @@ class Watch:
     travel_m: float = 0.0  # how far its estimate went from there while excluded
     receiver: bool = False  # the bias followed it: its receiver's, not a place's
     taught: list[Change] = field(default_factory=list)  # what it taught G while excluded
+    biased_at: np.ndarray | None = None  # its estimate at the last cycle with the bias seen
+    quiet_at: np.ndarray | None = None  # ... at the first cycle it was gone
+    biased_cycles: int = 0  # cycles it was seen since the exclusion
     motion_detectable_m: float | None = None  # its motion test's MDB this cycle
     fault_m: float = 0.0  # the undetected bias its estimate may carry (protection radius)
     protection_m: float | None = None  # its estimate's protection radius

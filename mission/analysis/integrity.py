@@ -13,9 +13,10 @@ excluded or withheld. From the tlog's truth and the vehicles' events:
   excluded is a **missed detection**;
 - an **integrity event** is a cycle at which an estimate's true error (the work UAV's xhat,
   or the estimate a support was sent) exceeded its protection radius;
-- a **false alarm** is an exclusion with no lying fault on that support and no zone bias at
-  its true position; an exclusion in a zone (a real bias, if often below the test's minimal
-  detectable bias in its worst direction) is a **zone exclusion**.
+- a **false alarm** is an exclusion with no lying fault on that support and no zone within
+  ``ZONE_TOLERANCE_M`` of its true position (SIM_STATE's 1e-7 degrees are 1.1 cm, and an MPC
+  keeps a support on a zone's face); an exclusion in a zone (a real bias, if often below the
+  test's minimal detectable bias in its worst direction) is a **zone exclusion**.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from mission.analysis.trace import RunTrace
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.model import World
 
+ZONE_TOLERANCE_M = 0.05  # a zone's box this much wider when judging a false alarm
 GLITCH_PARAMETERS = ("SIM_GPS1_GLTCH_X", "SIM_GPS1_GLTCH_Y", "SIM_GPS1_GLTCH_Z")
 LYING_FAILURES = ("gps stuck", "gps wrong", "gps delayed")
 
@@ -65,8 +67,10 @@ def integrity_metrics(
         "withheld_cycles": dict(sorted(withheld.items())),
         "ambiguous_cycles": sum(1 for _, v in verdicts if v["ambiguous"]),
         "lying_faults": sum(len(windows) for windows in faults.values()),
-        "time_to_detect_s": detection["delays"],
+        "detected_faults": len(detection["delays"]),
         "missed_detections": detection["missed"],
+        "time_to_detect_s": detection["delays"][0] if detection["delays"] else None,  # the first
+        "times_to_detect_s": detection["delays"],
         "false_alarms": false_alarms,
         "zone_exclusions": in_zones,
         "protection": protection_against_truth(trace, verdicts),
@@ -74,25 +78,36 @@ def integrity_metrics(
 
 
 def lying_faults(events: list[dict[str, Any]], end_s: float) -> dict[str, list[list[float]]]:
-    """Per support, the [start, end] windows in which its receiver lied."""
-    active: dict[tuple[str, str], float] = {}
-    windows: dict[str, list[list[float]]] = defaultdict(list)
-    for event in sorted(events, key=lambda e: e["t"]):
+    """Per support, the [start, end] windows in which its receiver lied; windows that touch
+    (a ramp of settings, each starting as the last ends) are one."""
+    changes = []
+    for event in events:
         vehicle, what = event["vehicle"], event["event"]
         name, _, value = what.partition("=")
         if name in GLITCH_PARAMETERS:
-            key, starts = (vehicle, name), _nonzero(value)
+            changes.append((event["t"], _nonzero(value), (vehicle, name)))
         elif what.startswith("gps "):
-            key, starts = (vehicle, "gps"), what in LYING_FAILURES
-        else:
-            continue
+            changes.append((event["t"], what in LYING_FAILURES, (vehicle, "gps")))
+    active: dict[tuple[str, str], float] = {}
+    windows: dict[str, list[list[float]]] = defaultdict(list)
+    for t, starts, key in sorted(changes, key=lambda c: (c[0], c[1])):  # ends first
         if key in active and not starts:
-            windows[vehicle].append([active.pop(key), event["t"]])
+            windows[key[0]].append([active.pop(key), t])
         elif starts and key not in active:
-            active[key] = event["t"]
+            active[key] = t
     for (vehicle, _), start in active.items():
         windows[vehicle].append([start, end_s])
-    return {vehicle: sorted(spans) for vehicle, spans in windows.items()}
+    return {vehicle: _merged(spans) for vehicle, spans in windows.items()}
+
+
+def _merged(spans: list[list[float]]) -> list[list[float]]:
+    merged: list[list[float]] = []
+    for start, end in sorted(spans):
+        if merged and start <= merged[-1][1] + 1e-9:
+            merged[-1][1] = max(merged[-1][1], end)
+        else:
+            merged.append([start, end])
+    return merged
 
 
 def _nonzero(value: str) -> bool:
@@ -133,7 +148,7 @@ def _unfaulted(
             continue
         system = VehicleIdentity.parse(name).system_id
         truth, known = trace.truth_at(system, [t])
-        biased = bool(known[0]) and bool(np.any(world.zone_offset(truth[:1])[0] != 0))
+        biased = bool(known[0]) and _near_a_zone(world, truth[0])
         in_zones += biased
         false_alarms += not biased
     return false_alarms, in_zones
@@ -174,3 +189,13 @@ def _true_error(trace: RunTrace, name: str, t: float) -> float | None:
         return None
     truth, known = trace.truth_at(system, [t])
     return float(np.linalg.norm(estimate - truth[0])) if known[0] else None
+
+
+def _near_a_zone(world: World, position: np.ndarray) -> bool:
+    """Whether ``position`` lies within ZONE_TOLERANCE_M of a zone with a bias."""
+    for zone in world.scenario.world.zones:
+        low = np.array(zone.min_m) - ZONE_TOLERANCE_M
+        high = np.array(zone.max_m) + ZONE_TOLERANCE_M
+        if np.any(zone.offset_m) and np.all((position >= low) & (position <= high)):
+            return True
+    return False

@@ -37,6 +37,16 @@ ROLE_METRICS = (
     ("roles.role_switches", "role switches"),
     ("roles.work_error_m.shadow.mean", "work UAV error in the shadow, mean [m]"),
 )
+# shown where the integrity monitor was on in some run (issue 45)
+INTEGRITY_METRICS = (
+    ("integrity.detected_faults", "lying faults detected"),
+    ("integrity.missed_detections", "lying faults missed"),
+    ("integrity.time_to_detect_s", "time to detect [s]"),
+    ("integrity.false_alarms", "false exclusions"),
+    ("integrity.zone_exclusions", "exclusions in a zone"),
+    ("integrity.protection.work.integrity_events", "work UAV integrity events"),
+    ("integrity.protection.supports.integrity_events", "supports' integrity events"),
+)
 PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
 
 
@@ -52,7 +62,8 @@ def write_report(
     inspected. With ``provenance``, its footer says where the numbers came from, and a
     historical study says so in the first line."""
     inspected = any(float(r.get("roles.support_minutes.inspecting") or 0) > 0 for r in rows)
-    shown = METRICS + (ROLE_METRICS if inspected else ())
+    watched = any(r.get("integrity.exclusions") is not None for r in rows)
+    shown = METRICS + (ROLE_METRICS if inspected else ()) + (INTEGRITY_METRICS if watched else ())
     metrics = tuple(m for m in shown if any(r.get(m[0]) is not None for r in rows))
     figures = write_figures(out_dir / "figures", spec, rows, metrics)
     first = historical_line(provenance)

@@ -68,18 +68,45 @@ class Point:
 
 def value_text(key: str, value: Any) -> str:
     """A point's value as its label shows it: a scenario's ``faults:`` entries as
-    ``support-1 gps off 10-40 s``, anything else as Python prints it."""
+    ``support-1 gps off 10-40 s``; a run of more than three settings of one vehicle's one
+    parameter back to back as a ramp (``support-1 SIM_GPS1_GLTCH_Z 0.1 to 3 in 30 steps,
+    10-40 s``); anything else as Python prints it."""
     if key != "faults" or not isinstance(value, list):
         return str(value)
+    if not all(isinstance(fault, dict) for fault in value):
+        return str(value)
+    ramp = _ramp_text(value)
+    if ramp is not None:
+        return ramp
     told = []
     for fault in value:
-        if not isinstance(fault, dict):
-            return str(value)
         what = fault.get("failure") or f"{fault.get('param')}={fault.get('value')}"
         start, duration = fault.get("at_s"), fault.get("duration_s")
         when = f"from {start} s" if duration is None else f"{start}-{start + duration:g} s"
         told.append(f"{fault.get('vehicle')} {what} {when}")
     return "; ".join(told) or "none"
+
+
+def _ramp_text(faults: list[dict[str, Any]]) -> str | None:
+    """More than three settings of one vehicle's one parameter, each starting as the last
+    ends, told as a ramp (None where the faults are not that)."""
+    firsts = faults[0]
+    same = all(
+        f.get("vehicle") == firsts.get("vehicle") and f.get("param") == firsts.get("param")
+        for f in faults
+    )
+    if len(faults) <= 3 or not same or firsts.get("param") is None:
+        return None
+    try:
+        ends = [float(f["at_s"]) + float(f["duration_s"]) for f in faults]
+        if any(abs(float(f["at_s"]) - end) > 1e-9 for f, end in zip(faults[1:], ends)):
+            return None
+    except (KeyError, TypeError, ValueError):
+        return None
+    return (
+        f"{firsts['vehicle']} {firsts['param']} {firsts.get('value')} to "
+        f"{faults[-1].get('value')} in {len(faults)} steps, {firsts['at_s']}-{ends[-1]:g} s"
+    )
 
 
 @dataclass(frozen=True)

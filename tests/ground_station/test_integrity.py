@@ -64,7 +64,7 @@ def _support(name, fix, relative=None) -> SupportMeasurement:
 def _primed(along, names=("support-1",), **changes) -> tuple[IntegrityMonitor, StationState]:
     """A monitor that has seen one cycle: each support at the origin, last covariance known,
     commanded 0.3 m east."""
-    monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False)
+    monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False, voxel_m=1.0)
     state = StationState(np.zeros(3), {n: np.zeros(3) for n in names}, 1)
     for name in names:
         monitor.watch(name).covariance = PREVIOUS.copy()
@@ -114,7 +114,7 @@ def test_a_smaller_bias_is_excluded_once_two_cycles_sum_past_their_gate(along):
 
 def _formation(biased: int, count: int, along, **changes):
     names = tuple(f"support-{n + 1}" for n in range(count))
-    monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False)
+    monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False, voxel_m=1.0)
     state = StationState(np.zeros(3), {n: np.zeros(3) for n in names}, 1)
     work = np.array([0.0, 0.0, 5.0])
     supports = []
@@ -146,17 +146,33 @@ def test_two_supports_that_disagree_cannot_be_told_apart_and_both_are_withheld(a
     assert not verdict.events
 
 
-def test_an_excluded_support_is_restored_after_its_quiet_cycles(along):
+def _excluded_then_quiet(along, moved_m: float) -> list[str]:
+    """A support excluded for a 2.2 m step, then quiet for three cycles, having moved
+    ``moved_m`` east between its last biased cycle and its first quiet one: the events."""
     monitor, state = _primed(along, sustain_cycles=1, recovery_cycles=3)
     big = np.array([0.3 + 2.2, 0.0, 0.0])
     assert monitor.check([_support("support-1", big)], state).excluded == {"support-1"}
     state.last_support_command["support-1"] = np.zeros(3)
-    state.yhat["support-1"] = np.array([0.3, 0.0, 0.0])
+    here = np.array([0.3, 0.0, 0.0])
+    state.yhat["support-1"] = here
+    for _ in range(3):  # still biased, here, as long as it takes to be restored
+        monitor.check([_support("support-1", here + [2.2, 0, 0])], state)
+    there = here + [moved_m, 0.0, 0.0]
+    state.yhat["support-1"] = there
     kinds = []
     for _ in range(3):  # the fix is back where the support is
-        verdict = monitor.check([_support("support-1", [0.3, 0.0, 0.0])], state)
+        verdict = monitor.check([_support("support-1", there)], state)
         kinds += [event.kind for event in verdict.events]
-    assert kinds == ["restored"] and not verdict.excluded
+    assert not verdict.excluded
+    return kinds
+
+
+def test_a_bias_gone_where_its_support_left_it_was_a_places(along):
+    assert _excluded_then_quiet(along, moved_m=1.5) == ["restored"]
+
+
+def test_a_bias_gone_while_its_support_stayed_in_its_voxel_was_the_receivers(along):
+    assert _excluded_then_quiet(along, moved_m=0.2) == ["receiver", "restored"]
 
 
 def test_a_bias_that_follows_its_support_is_its_receivers_and_g_forgets_it(along, along_world):
