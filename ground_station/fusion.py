@@ -27,6 +27,16 @@ class SupportMeasurement:
     sigma_gnss_m2: np.ndarray | None
     relative_m: np.ndarray | None
     sigma_relative_m2: np.ndarray | None
+    reported_m2: np.ndarray | None = None  # the receiver's own accuracy (GPS_RAW_INT)
+
+    @property
+    def sigma_gnss_tested_m2(self) -> np.ndarray | None:
+        """Sigma_GNSS as the integrity monitor tests it: the model's, or the receiver's own
+        where that says it is worse (larger trace)."""
+        model, reported = self.sigma_gnss_m2, self.reported_m2
+        if model is None or reported is None or np.trace(reported) <= np.trace(model):
+            return model
+        return reported
 
     @property
     def contributes(self) -> bool:

@@ -123,6 +123,8 @@ def localize(values: Sequence[SupportReport], world: KnownWorld) -> list[Support
         sigma_gnss = sigma_of.get(v.name)
         fix = v.fix if sigma_gnss is not None else None
         measurements.append(
-            SupportMeasurement(v.name, fix, sigma_gnss, v.relative, sigma_relative_of.get(v.name))
+            SupportMeasurement(
+                v.name, fix, sigma_gnss, v.relative, sigma_relative_of.get(v.name), v.reported
+            )
         )
     return measurements

@@ -14,8 +14,7 @@ import numpy as np
 from ground_station.fusion import FusionResult, SupportMeasurement
 from ground_station.gnss_map import LocalizabilityMap
 from ground_station.integrity.consistency import Formation
-from ground_station.integrity.protection import detectable_bias
-from ground_station.integrity.small import inverse3
+from ground_station.integrity.protection import detectable_bias, fault_shift
 from ground_station.integrity.verdict import Event, Verdict, Watch
 from ground_station.state import StationState
 from mission.config.integrity_settings import IntegritySettings
@@ -83,21 +82,14 @@ def _fault_term(monitor: IntegrityMonitor, used: list[str], covariance: np.ndarr
     a fault is no likelier than the integrity risk: :mod:`~.protection`)."""
     if monitor.fault_detectable == 0.0:
         return 0.0
-    scale = np.sqrt(monitor.fault_detectable / monitor.detectable)
-    fault = 0.0
-    for name in used:
-        information = monitor.formation.information[name]
-        others = [other for other in used if other != name]
-        if others:
-            rest = inverse3(sum(monitor.formation.information[o] for o in others))
-            bound = detectable_bias(
-                monitor.formation.members[name].sigma + rest, monitor.fault_detectable
-            )
-        else:
-            own = monitor.watch(name).motion_detectable_m
-            bound = float("inf") if own is None else own * scale
-        fault = max(fault, float(np.linalg.norm(covariance @ information, 2)) * bound)
-    return fault
+    formation = monitor.formation
+    lone = None
+    if len(used) == 1 and monitor.watch(used[0]).motion_detectable_m is not None:
+        own = monitor.watch(used[0]).motion_detectable_m
+        lone = own * np.sqrt(monitor.fault_detectable / monitor.detectable)
+    information = {name: formation.information[name] for name in used}
+    sigma = {name: formation.sigma[name] for name in used}
+    return fault_shift(covariance, information, sigma, monitor.fault_detectable, lone)
 
 
 def _navigate(

@@ -5,6 +5,10 @@ statistic T = nu^T S^-1 nu of a 3-vector innovation nu with its covariance S.
   put it, d_n = yhat_n + m_n: nu = p_n - d_n, S = Sigma_GNSS(p_n) + P_n + q^2 I, with P_n the
   last estimate's covariance and q the spread of where a vehicle ends against its command.
   It catches a step at its start.
+
+Sigma_GNSS is the model's at p_n, or the receiver's own report (GPS_RAW_INT's h_acc and v_acc)
+where that is worse: a receiver that knows it is poor widens its tests rather than being
+excluded for noise it has announced.
 - **Formation**: mu_n = p_n + r_n (where the support's fix and sighting put the work UAV)
   against the other supports' estimate of the work UAV, x_-n = (sum Sigma_m^-1)^-1 sum
   Sigma_m^-1 mu_m over the others m: nu = mu_n - x_-n, S = Sigma_n + (sum Sigma_m^-1)^-1. It
@@ -48,10 +52,11 @@ def motion_innovation(
     motion_sigma_m: float,
 ) -> Innovation | None:
     """The motion test's innovation (None without a fix)."""
-    if support.fix_m is None or support.sigma_gnss_m2 is None:
+    gnss = support.sigma_gnss_tested_m2
+    if support.fix_m is None or gnss is None:
         return None
     expected = previous_yhat + moved
-    covariance = support.sigma_gnss_m2 + previous_covariance
+    covariance = gnss + previous_covariance
     covariance[np.diag_indices(3)] += motion_sigma_m**2
     return Innovation(support.fix_m - expected, covariance)
 
@@ -62,7 +67,8 @@ class Formation:
 
     def __init__(self, measurements: Sequence[SupportMeasurement]) -> None:
         self.members = {m.name: m for m in measurements if m.contributes}
-        self.information = {name: inverse3(m.sigma) for name, m in self.members.items()}
+        self.sigma = {name: _tested_sigma(m) for name, m in self.members.items()}
+        self.information = {name: inverse3(self.sigma[name]) for name in self.members}
         self.weighted = {name: self.information[name] @ m.mu for name, m in self.members.items()}
 
     def estimate(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray] | None:
@@ -85,7 +91,14 @@ class Formation:
         if found is None:
             return None
         position, covariance = found
-        return Innovation(support.mu - position, support.sigma + covariance)
+        return Innovation(support.mu - position, self.sigma[name] + covariance)
+
+
+def _tested_sigma(support: SupportMeasurement) -> np.ndarray:
+    """Sigma_n as the monitor tests it: Sigma_GNSS (or the receiver's own, worse) + Sigma_r."""
+    gnss, relative = support.sigma_gnss_tested_m2, support.sigma_relative_m2
+    assert gnss is not None and relative is not None
+    return gnss + relative
 
 
 def formation_estimate(

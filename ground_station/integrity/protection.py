@@ -16,11 +16,9 @@ fault term where the formation placed it.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
-from ground_station.fusion import SupportMeasurement
+from ground_station.integrity.small import inverse3
 
 
 def no_fault_radius(covariance: np.ndarray, k2: float) -> float:
@@ -34,26 +32,25 @@ def detectable_bias(covariance: np.ndarray, detectable: float) -> float:
     return float(np.sqrt(detectable * max(float(np.linalg.eigvalsh(covariance)[-1]), 0.0)))
 
 
-def fused_protection(
-    used: Sequence[SupportMeasurement],
+def fault_shift(
+    covariance: np.ndarray,
+    information: dict[str, np.ndarray],
+    sigma: dict[str, np.ndarray],
     detectable: float,
-    k2: float,
-    motion_detectable: dict[str, float],
-) -> tuple[float, float] | None:
-    """(the work UAV's protection radius, its fault term) from the supports fused (None:
-    none). Each support's undetected bias is bounded by its formation test's MDB against the
-    others, or, fused alone, by its motion test's (infinite without one)."""
-    if not used:
-        return None
-    inverses = [np.linalg.inv(m.sigma) for m in used]
-    covariance = np.linalg.inv(sum(inverses))
-    fault = 0.0
-    for i, m in enumerate(used):
-        others = [inverse for j, inverse in enumerate(inverses) if j != i]
+    lone_bound: float | None,
+) -> float:
+    """The largest shift an undetected fault in one fused support can make in an estimate
+    with ``covariance`` fused from ``information`` (Sigma_m^-1 by support): ||W_m|| MDB_m,
+    W_m = P Sigma_m^-1, MDB_m the formation test's against the others (``sigma``: each
+    Sigma_m as tested), or, fused alone, ``lone_bound`` (its motion test's; None: unbounded).
+    """
+    shift = 0.0
+    for name, inverse in information.items():
+        others = [other for other in information if other != name]
         if others:
-            bound = detectable_bias(m.sigma + np.linalg.inv(sum(others)), detectable)
+            rest = inverse3(sum(information[other] for other in others))
+            bound = detectable_bias(sigma[name] + rest, detectable)
         else:
-            bound = motion_detectable.get(m.name, float("inf"))
-        gain = float(np.linalg.norm(covariance @ inverses[i], 2))
-        fault = max(fault, gain * bound)
-    return no_fault_radius(covariance, k2) + fault, fault
+            bound = float("inf") if lone_bound is None else lone_bound
+        shift = max(shift, float(np.linalg.norm(covariance @ inverse, 2)) * bound)
+    return shift

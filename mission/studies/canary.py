@@ -1,13 +1,15 @@
-"""The canary: two short fixed runs a study makes at its start, whose decisions' digests
+"""The canary: three short fixed runs a study makes at its start, whose decisions' digests
 (:mod:`mission.analysis.decisions`) stand for what the code and machine decide.
 
 A committed study's ``provenance.json`` keeps the canary its code gave. Today's code giving
 another canary means the study's numbers may no longer be what the code gives: ``mission
 study --verify`` says so first, and the suite fails until the study is made again or marked
-historical (docs/development.md). Between them the two runs exercise the defaults' whole
-cycle (GNSS from the sky and the zones, the fusion, G, the MPCs with their margins) with
-kinematic points in Along, and a flying quadrotor in gusty wind with dynamic roles, routes and
-the work UAV's own fix in piers: 40 simulated seconds each, about 3 and 6 s of wall time.
+historical (docs/development.md). Between them the runs exercise the defaults' whole cycle
+(GNSS from the sky and the zones, the fusion, G, the MPCs with their margins) with kinematic
+points in Along; a flying quadrotor in gusty wind with dynamic roles, routes and the work
+UAV's own fix in piers; and the integrity monitor excluding and restoring a glitched support
+in Along: 40 simulated seconds each, about 3, 6 and 3 s of wall time. A study made before a
+run joined the canary is compared on the runs both have.
 """
 
 from __future__ import annotations
@@ -52,16 +54,37 @@ CANARY = (
         "ac",
         0,
     ),
+    CanaryRun(
+        "along",
+        (
+            ("run.timeout_s", CANARY_S),
+            ("integrity.enabled", True),
+            (
+                "faults",
+                [
+                    {
+                        "at_s": 10,
+                        "vehicle": "support-1",
+                        "param": "SIM_GPS1_GLTCH_X",
+                        "value": 0.00002,
+                        "duration_s": 15,
+                    }
+                ],
+            ),
+        ),
+        "ac",
+        0,
+    ),
 )
 
 
 def canary_runs(code: str) -> list[StudyRun]:
-    """The canary's runs, keyed as a study's runs are (named ``canary-<scenario>``, so a
+    """The canary's runs, keyed as a study's runs are (named ``canary-<scenario>-<n>``, so a
     shared runs folder holds them once per code version)."""
     runs = []
     for number, canary in enumerate(CANARY):
         point = Point(canary.overrides)
-        where = (canary.scenario, f"canary-{canary.scenario}", number, point)
+        where = (canary.scenario, f"canary-{canary.scenario}-{number}", number, point)
         resolved = resolved_key(canary.scenario, point)
         runs.append(keyed_run(where, resolved, canary.method, canary.seed, code))
     return runs
@@ -82,3 +105,14 @@ def canary_record(summaries: list[dict[str, Any] | None]) -> dict[str, Any]:
             for canary, digest in zip(CANARY, digests)
         ],
     }
+
+
+def canary_differences(theirs: dict[str, Any] | None, today: dict[str, Any]) -> list[str] | None:
+    """The canary runs whose digests differ between a study's canary and today's, over the
+    runs both name (None where they share none, or either has no digest for one)."""
+    mine = {r["run"]: r.get("decisions_digest") for r in today.get("runs", [])}
+    old = {r["run"]: r.get("decisions_digest") for r in (theirs or {}).get("runs", [])}
+    shared = [run for run in old if run in mine]
+    if not shared or any(old[run] is None or mine[run] is None for run in shared):
+        return None
+    return [run for run in shared if old[run] != mine[run]]

@@ -17,7 +17,7 @@ from typing import Any, TextIO
 
 from mission.config.errors import InputError
 from mission.procs.atomic import write_text_atomically
-from mission.studies.canary import canary_record, canary_runs
+from mission.studies.canary import canary_differences, canary_record, canary_runs
 from mission.studies.provenance_file import read_provenance
 from mission.studies.results import read_results_csv, result_row, results_csv
 from mission.studies.runkeys import StudyRun, code_version
@@ -119,19 +119,22 @@ def run_label(run: StudyRun) -> str:
 
 
 def canary_verdict(committed: dict[str, Any] | None, summaries: list[dict | None]) -> str:
-    """What --verify says once the canary is made: the study's canary against today's."""
-    today = canary_record(summaries)["digest"]
-    if today is None:
+    """What --verify says once the canary is made: the study's canary against today's, run by
+    run over the runs both have."""
+    today = canary_record(summaries)
+    if today["digest"] is None:
         return "canary: FAILED to run; today's decisions are unknown"
     if not committed:
-        return f"canary: {today}; the study has no provenance.json to compare it with"
-    theirs = (committed.get("canary") or {}).get("digest")
+        return f"canary: {today['digest']}; the study has no provenance.json to compare it with"
     commit = str(committed.get("commit") or "an unknown commit")[:12]
-    if theirs == today:
-        return f"canary: {today}, as when the study was made (commit {commit})"
+    differing = canary_differences(committed.get("canary"), today)
+    if differing is None:
+        return f"canary: {today['digest']}; the study's canary (commit {commit}) shares no run"
+    if not differing:
+        return f"canary: {today['digest']}, as when the study was made (commit {commit})"
     return (
-        f"canary: STALE: the study was made with commit {commit} (canary {theirs}); today's "
-        f"code and machine give {today}, so its numbers may not be today's"
+        f"canary: STALE: the study was made with commit {commit}; today's code and machine "
+        f"decide otherwise in {'; '.join(differing)}, so its numbers may not be today's"
     )
 
 
@@ -219,7 +222,7 @@ def run_verify(
     today = {run: result_row(spec, run, s) for run, s in summaries.items() if s and run in rows}
     found = compare_rows(spec, chosen, today)
     lines = [heading, *verdict, "", *report_lines(chosen, found)]
-    stale = bool(verdict) and "STALE" in verdict[0]
+    stale = bool(verdict) and ("STALE" in verdict[0] or "shares no run" in verdict[0])
     agrees = not found.differences and not found.failed and not stale
     lines.append("verified: every compared row is as committed" if agrees else "NOT verified")
     write_text_atomically(out_dir / "verify.md", "\n".join(lines) + "\n")

@@ -217,7 +217,7 @@ def test_an_excluded_supports_margins_are_wider_and_unused_slots_stay_unused():
 def test_the_protection_radii_by_hand():
     from ground_station.integrity.protection import (
         detectable_bias,
-        fused_protection,
+        fault_shift,
         no_fault_radius,
     )
 
@@ -226,19 +226,15 @@ def test_the_protection_radii_by_hand():
     assert no_fault_radius(covariance, k2) == pytest.approx(np.sqrt(k2 * 0.09))
     lam = detectable_noncentrality(1e-5, 1e-3)
     assert detectable_bias(covariance, lam) == pytest.approx(np.sqrt(lam * 0.09))
-    work = np.array([0.0, 0.0, 5.0])
-    supports = [
-        _support(f"support-{n}", [x, 6.0, 7.0], work - [x, 6.0, 7.0])
-        for n, x in ((1, -3.0), (2, 3.0))
-    ]
     # two equal supports: P = Sigma / 2, each weighs 1/2; the other's MDB bounds each bias
     sigma = SIGMA_GNSS + SIGMA_R
-    radius, fault = fused_protection(supports, lam, k2, {})
-    expected_fault = 0.5 * np.sqrt(lam * np.linalg.eigvalsh(sigma + sigma)[-1])
-    assert fault == pytest.approx(expected_fault, rel=1e-9)
-    assert radius == pytest.approx(no_fault_radius(sigma / 2, k2) + expected_fault, rel=1e-9)
-    # a fault no likelier than the risk: no fault term
-    assert fused_protection(supports, 0.0, k2, {})[1] == 0.0
+    information = {"a": np.linalg.inv(sigma), "b": np.linalg.inv(sigma)}
+    shift = fault_shift(sigma / 2, information, {"a": sigma, "b": sigma}, lam, None)
+    assert shift == pytest.approx(0.5 * np.sqrt(lam * np.linalg.eigvalsh(2 * sigma)[-1]))
+    # fused alone, the motion test's bound, or none
+    alone = {"a": np.linalg.inv(sigma)}
+    assert fault_shift(sigma, alone, {"a": sigma}, lam, 0.7) == pytest.approx(0.7)
+    assert fault_shift(sigma, alone, {"a": sigma}, lam, None) == float("inf")
 
 
 def test_the_plain_float_inverse_and_quadratic_are_numpys():
@@ -253,3 +249,18 @@ def test_the_plain_float_inverse_and_quadratic_are_numpys():
         assert quadratic3(v, inverse3(matrix)) == pytest.approx(v @ np.linalg.solve(matrix, v))
     with pytest.raises(ValueError, match="singular"):
         inverse3(np.zeros((3, 3)))
+
+
+def test_a_receiver_that_reports_itself_poor_widens_its_own_tests(along):
+    monitor, state = _primed(along, sustain_cycles=1)
+    bias = np.array([0.8, 0.0, 0.0])
+    fix = np.array([0.3, 0.0, 0.0]) + bias
+    plain = monitor.check([_support("support-1", fix)], state).statistics["support-1"]
+    monitor, state = _primed(along, sustain_cycles=1)
+    reported = np.diag([0.25, 0.25, 0.5])  # it says 0.5 m horizontally
+    poor = dataclasses.replace(_support("support-1", fix), reported_m2=reported)
+    verdict = monitor.check([poor], state)
+    wide = verdict.statistics["support-1"]["motion"]
+    by_hand = 0.8**2 / (reported[0, 0] + PREVIOUS[0, 0] + Q**2)
+    assert wide == pytest.approx(by_hand, rel=1e-12) and wide < plain["motion"]
+    assert not verdict.excluded  # the 0.8 m it may be off is within what it said

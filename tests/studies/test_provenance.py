@@ -33,13 +33,14 @@ def made(tmp_path):
 
 def test_the_canary_runs_first_and_its_digest_is_the_provenances(made):
     study, engine = made
-    assert [folder.split("-ac-")[0] for folder in engine.ran[:2]] == [
-        "canary-along",
-        "canary-piers",
+    assert [folder.split("-ac-")[0] for folder in engine.ran[:3]] == [
+        "canary-along-0",
+        "canary-piers-1",
+        "canary-along-2",
     ]
-    assert not any(folder.startswith("canary") for folder in engine.ran[2:])
+    assert not any(folder.startswith("canary") for folder in engine.ran[3:])
     provenance = read_provenance(study)
-    digests = [f"canary-{c.scenario}-{n}-ac-0" for n, c in enumerate(CANARY)]
+    digests = [f"canary-{c.scenario}-{n}-{n}-ac-0" for n, c in enumerate(CANARY)]
     expected = hashlib.sha256(json.dumps(digests).encode()).hexdigest()[:16]
     assert provenance["canary"]["digest"] == expected
     assert [r["decisions_digest"] for r in provenance["canary"]["runs"]] == digests
@@ -143,9 +144,20 @@ def test_a_changed_cell_is_listed_and_fails_but_a_timing_is_not_compared(made, t
 def test_a_stale_canary_is_said_at_once_with_the_commit(made, tmp_path):
     study, _ = made
     provenance = read_provenance(study)
-    provenance["canary"]["digest"] = "0" * 16
+    provenance["canary"]["runs"][1]["decisions_digest"] = "0" * 16
     (study / "provenance.json").write_text(json.dumps(provenance))
     outcome, progress = _verify(study, tmp_path, count=1)
     assert not outcome.agrees
     said = progress.splitlines()[1]
     assert said.startswith("canary: STALE") and provenance["commit"][:12] in said
+    assert provenance["canary"]["runs"][1]["run"] in said and "along AC" not in said
+
+
+def test_a_study_made_before_a_canary_run_joined_is_compared_on_the_runs_it_has(made, tmp_path):
+    study, _ = made
+    provenance = read_provenance(study)
+    provenance["canary"]["runs"] = provenance["canary"]["runs"][:2]  # an older canary
+    provenance["canary"]["digest"] = "older"
+    (study / "provenance.json").write_text(json.dumps(provenance))
+    outcome, progress = _verify(study, tmp_path, count=1)
+    assert outcome.agrees and "as when the study was made" in progress.splitlines()[1]

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from mission.studies.canary import canary_record, canary_runs
+from mission.studies.canary import canary_differences, canary_record, canary_runs
 from mission.studies.local_engine import LocalEngine
 from mission.studies.provenance_file import read_provenance
 from mission.studies.results import read_results_csv
@@ -40,11 +40,11 @@ def test_every_committed_study_gives_todays_canary_or_is_marked_historical(canar
     for folder in sorted(p for p in COMMITTED.iterdir() if p.is_dir()):
         provenance = read_provenance(folder)
         if provenance is None or provenance.get("historical"):
-            continue  # test_provenance_files: each has one (and historical ones say why)
-        theirs = (provenance.get("canary") or {}).get("digest")
-        if theirs != today["digest"]:
+            continue  # test_committed: each has one (and historical ones say why)
+        differing = canary_differences(provenance.get("canary"), today)
+        if differing != []:
             commit = str(provenance.get("commit"))[:12]
-            stale.append(f"{folder.name} (made with {commit}, canary {theirs})")
+            stale.append(f"{folder.name} (made with {commit}: {differing or 'no shared run'})")
     assert not stale, (
         f"today's canary is {today['digest']} ({today['runs']}); these studies were made "
         f"with other decisions: re-run them or mark them historical: {', '.join(stale)}"
