@@ -16,9 +16,15 @@ from mission.studies.stats import bootstrap_ci, mean_ci
 def write_figures(
     folder: Path, spec: StudySpec, rows: list[dict], metrics: tuple[tuple[str, str], ...]
 ) -> list[Path]:
-    """Write the figures; return their paths (none without rows)."""
+    """Write the figures; return their paths (none without rows). A metric that is 0 in every
+    row (a kinematic point's tracking error) draws a flat line and is left out."""
     if not rows:
         return []
+    metrics = tuple(
+        (column, label)
+        for column, label in metrics
+        if any(float(r.get(column) or 0) != 0 for r in rows)
+    )
     import matplotlib
 
     matplotlib.use("Agg")

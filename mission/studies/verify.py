@@ -191,9 +191,11 @@ def run_verify(
     chosen = draw(committed_rows(against, plan_runs(spec, code)), count, seed)
     committed = read_provenance(against)
     total = len(read_results_csv((against / "results.csv").read_text(encoding="utf-8")))
-    drawn = "all" if len(chosen) == total else f"drawn with seed {seed}"
-    heading = f"verifying {len(chosen)} of {total} rows of {against} ({drawn}): "
-    heading += ", ".join(run_label(run) for run, _ in chosen)
+    if len(chosen) == total:
+        heading = f"verifying all {total} rows of {against}"
+    else:
+        heading = f"verifying {len(chosen)} of {total} rows of {against} (drawn with seed {seed}): "
+        heading += ", ".join(run_label(run) for run, _ in chosen)
     progress.write(heading + "\n")
     canaries = canary_runs(code)
     runs_dir = runs_dir or out_dir / "runs"
