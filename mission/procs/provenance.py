@@ -39,6 +39,17 @@ def code_identity(root: Path = _SOURCE_ROOT) -> dict[str, Any]:
     }
 
 
+def last_commit_of(path: Path) -> str | None:
+    """The last commit that changed ``path`` (followed across renames; None outside a git
+    checkout or for a file git never had)."""
+    path = path.resolve()
+    root = _git(path.parent, "rev-parse", "--show-toplevel")
+    if not root:
+        return None
+    found = _git(Path(root), "log", "-1", "--follow", "--format=%H", "--", str(path))
+    return found or None
+
+
 def environment() -> dict[str, Any]:
     """The packages' versions, Python's, and the machine (with its numerics)."""
     return {
@@ -62,7 +73,7 @@ def _version(distribution: str) -> str | None:
 
 def _git(root: Path, *arguments: str) -> str | None:
     """git's output in ``root`` (stripped), or None where there is no git or no checkout."""
-    if not (root / ".git").exists():
+    if not any((folder / ".git").exists() for folder in (root, *root.parents)):
         return None
     try:
         done = subprocess.run(

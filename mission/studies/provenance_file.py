@@ -16,7 +16,7 @@ from typing import Any
 
 from mission.config.errors import InputError
 from mission.procs.atomic import write_text_atomically
-from mission.procs.provenance import code_identity, environment
+from mission.procs.provenance import code_identity, environment, last_commit_of
 
 PROVENANCE_FILE = "provenance.json"
 
@@ -58,8 +58,9 @@ def historical_line(provenance: dict[str, Any] | None) -> str | None:
     """The report's first line for a study marked historical (None otherwise)."""
     if not provenance or not provenance.get("historical"):
         return None
+    made = "committed with" if provenance.get("committed_with") else "made with"
     return (
-        f"> **Historical**: made with commit {_short(provenance.get('commit'))}; today's code "
+        f"> **Historical**: {made} commit {_short(provenance.get('commit'))}; today's code "
         f"does not give these numbers ({provenance['historical']})."
     )
 
@@ -114,9 +115,14 @@ def _short(commit: Any) -> str:
 
 def mark_historical(out_dir: Path, why: str) -> None:
     """Mark a study historical (its numbers are not what today's code gives), saying why, in
-    its provenance.json (made, with an unknown commit, where it has none)."""
+    its provenance.json; one made before provenance existed gets one naming the last commit
+    that changed its results.csv (the commit they were committed with)."""
     if not why.strip():
         raise InputError("command line", "--historical", "must say why the study is historical")
-    provenance = read_provenance(out_dir) or {"study": out_dir.name, "commit": None}
+    provenance = read_provenance(out_dir) or {
+        "study": out_dir.name,
+        "commit": last_commit_of(out_dir / "results.csv"),
+        "committed_with": True,  # the commit that committed the results, not one that ran them
+    }
     provenance["historical"] = why.strip()
     write_provenance(out_dir, provenance)

@@ -20,6 +20,7 @@ from mission.studies.provenance_file import mark_historical, read_provenance
 from mission.studies.runkeys import code_version
 from mission.studies.study import rewrite_report, run_study
 from mission.studies.verify import draw, run_verify
+from tests.processes import ROOT
 from tests.studies.test_study import FakeEngine, _spec
 
 
@@ -90,9 +91,23 @@ def test_a_study_without_provenance_is_marked_with_an_unknown_commit(tmp_path):
     mark_historical(tmp_path, "older than provenance")
     assert read_provenance(tmp_path) == {
         "study": tmp_path.name,
-        "commit": None,
+        "commit": None,  # not in a git checkout
+        "committed_with": True,
         "historical": "older than provenance",
     }
+
+
+def test_a_committed_study_without_provenance_names_the_commit_that_committed_it(tmp_path):
+    folder = ROOT / "docs" / "studies" / "table3"
+    log = subprocess.run(
+        ["git", "log", "-1", "--follow", "--format=%H", "--", "results.csv"],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+    )
+    from mission.procs.provenance import last_commit_of
+
+    assert last_commit_of(folder / "results.csv") == log.stdout.strip()
 
 
 def test_a_broken_provenance_file_is_bad_input_naming_it(tmp_path):
