@@ -43,12 +43,18 @@ def survival(x: float, dof: int) -> float:
 
 def gate(false_alarm: float, dof: int = 3) -> float:
     """The x at which a no-fault statistic exceeds x with probability ``false_alarm``."""
-    low, high = 0.0, float(dof)
-    while survival(high, dof) > false_alarm:
+    return _solve_falling(lambda x: survival(x, dof), false_alarm, float(dof))
+
+
+def _solve_falling(function, target: float, start: float) -> float:
+    """The x >= 0 at which a falling ``function`` crosses ``target``, by bisection to a
+    relative 1e-12 (each is solved once per run)."""
+    low, high = 0.0, start
+    while function(high) > target:
         high *= 2
-    for _ in range(200):  # bisection to a relative 1e-12: the gate is set once per run
+    for _ in range(200):
         middle = (low + high) / 2
-        if survival(middle, dof) > false_alarm:
+        if function(middle) > target:
             low = middle
         else:
             high = middle
@@ -81,15 +87,4 @@ def detectable_noncentrality(false_alarm: float, missed_detection: float) -> flo
     """lambda* at which a 3-dof test at ``false_alarm``'s gate misses with probability
     ``missed_detection``: a bias b is detected at least that often where b^T S^-1 b >= lambda*."""
     threshold = gate(false_alarm, 3)
-    low, high = 0.0, threshold
-    while noncentral_cdf_3(threshold, high) > missed_detection:
-        high *= 2
-    for _ in range(200):
-        middle = (low + high) / 2
-        if noncentral_cdf_3(threshold, middle) > missed_detection:
-            low = middle
-        else:
-            high = middle
-        if high - low < 1e-12 * high:
-            break
-    return (low + high) / 2
+    return _solve_falling(lambda lam: noncentral_cdf_3(threshold, lam), missed_detection, threshold)

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.procs.json_files import read_json_object
 
 
 def run_scenario(given: Path, run_dir: Path, previous: dict, explicit: str | None):
@@ -31,12 +31,4 @@ def run_scenario(given: Path, run_dir: Path, previous: dict, explicit: str | Non
 def previous_summary(path: Path) -> dict:
     """The summary.json beside a tlog ({} if there is none); one line naming it if it is not
     a JSON object."""
-    if not path.is_file():
-        return {}
-    try:
-        summary = json.loads(path.read_text(encoding="utf-8"))
-    except (ValueError, OSError) as error:
-        raise InputError(str(path), "", f"not a readable JSON summary ({error})") from None
-    if not isinstance(summary, dict):
-        raise InputError(str(path), "", "not a JSON object")
-    return summary
+    return read_json_object(path) or {}

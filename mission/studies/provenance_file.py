@@ -16,6 +16,7 @@ from typing import Any
 
 from mission.config.errors import InputError
 from mission.procs.atomic import write_text_atomically
+from mission.procs.json_files import read_json_object
 from mission.procs.provenance import code_identity, environment, last_commit_of
 
 PROVENANCE_FILE = "provenance.json"
@@ -42,16 +43,7 @@ def write_provenance(out_dir: Path, provenance: dict[str, Any]) -> None:
 def read_provenance(out_dir: Path) -> dict[str, Any] | None:
     """A study folder's provenance.json (None where it has none); one that cannot be read as
     an object is bad input naming the file."""
-    path = out_dir / PROVENANCE_FILE
-    if not path.is_file():
-        return None
-    try:
-        provenance = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:
-        raise InputError(str(path), "", f"cannot be read as JSON ({error})") from None
-    if not isinstance(provenance, dict):
-        raise InputError(str(path), "", "must hold a JSON object")
-    return provenance
+    return read_json_object(out_dir / PROVENANCE_FILE)
 
 
 def historical_line(provenance: dict[str, Any] | None) -> str | None:
