@@ -90,12 +90,14 @@ def value_text(key: str, value: Any) -> str:
 def _ramp_text(faults: list[dict[str, Any]]) -> str | None:
     """More than three settings of one vehicle's one parameter, each starting as the last
     ends, told as a ramp (None where the faults are not that)."""
+    if len(faults) <= 3:
+        return None
     firsts = faults[0]
     same = all(
         f.get("vehicle") == firsts.get("vehicle") and f.get("param") == firsts.get("param")
         for f in faults
     )
-    if len(faults) <= 3 or not same or firsts.get("param") is None:
+    if not same or firsts.get("param") is None:
         return None
     try:
         ends = [float(f["at_s"]) + float(f["duration_s"]) for f in faults]

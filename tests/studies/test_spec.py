@@ -158,3 +158,24 @@ def test_a_study_over_an_hour_is_announced_with_its_estimate(monkeypatch):
     note = duration_note(1_000_000, 2)  # 7 CPU-s a run on 2 cores: 3.5e6 s
     assert note is not None and "about 40.5 days on 2 cores" in note
     assert "per core of the cluster" in duration_note(2000, None)
+
+
+def test_a_points_faults_are_told_briefly_and_a_ramp_as_a_ramp():
+    from mission.studies.spec import value_text
+
+    assert value_text("faults", []) == "none"
+    one = [{"at_s": 10, "vehicle": "support-1", "failure": "gps off", "duration_s": 30}]
+    assert value_text("faults", one) == "support-1 gps off 10-40 s"
+    ramp = [
+        {
+            "at_s": 10 + k,
+            "vehicle": "support-1",
+            "param": "SIM_GPS1_GLTCH_Z",
+            "value": 0.1 * (k + 1),
+            "duration_s": 1,
+        }
+        for k in range(5)
+    ]
+    assert value_text("faults", ramp) == "support-1 SIM_GPS1_GLTCH_Z 0.1 to 0.5 in 5 steps, 10-15 s"
+    apart = [dict(fault, at_s=fault["at_s"] * 2) for fault in ramp]  # not back to back
+    assert value_text("faults", apart).count(";") == 4
