@@ -105,18 +105,33 @@ def _navigate(
     term), its covariance, and the undetected bias it may carry."""
     watch = monitor.watch(m.name)
     xhat_covariance, fault_x = work
+    drift = monitor.motion_sigma_m**2 * np.eye(3)
     if withheld and xhat_covariance is not None and m.relative_m is not None:
         assert fusion.xhat is not None and m.sigma_relative_m2 is not None
         state.yhat[m.name] = fusion.xhat - m.relative_m
         watch.covariance = xhat_covariance + m.sigma_relative_m2
         watch.fault_m = fault_x
+        _refer(watch, state.yhat[m.name], watch.covariance)  # the formation's, not the fix
     elif not withheld and m.fix_m is not None and m.sigma_gnss_m2 is not None:
         watch.covariance = m.sigma_gnss_m2.copy()
         if m.relative_m is not None and m.sigma_relative_m2 is not None:
             watch.covariance += m.sigma_relative_m2  # yhat mixes the fix and x - r
         watch.fault_m = _own_fault(monitor, watch, m)
-    elif watch.covariance is not None:  # dead-reckoned by the fusion: it drifts
-        watch.covariance = watch.covariance + monitor.motion_sigma_m**2 * np.eye(3)
+        tested = m.sigma_gnss_tested_m2
+        assert tested is not None
+        _refer(watch, m.fix_m, tested)  # a trusted fix: the next test's reference
+    else:  # dead-reckoned by the fusion: it drifts, and so does the motion reference
+        if watch.covariance is not None:
+            watch.covariance = watch.covariance + drift
+        if watch.predicted is not None and watch.reference_covariance is not None:
+            _refer(watch, watch.predicted, watch.reference_covariance + drift)
+
+
+def _refer(watch: Watch, position: np.ndarray, covariance: np.ndarray) -> None:
+    """The motion test's next reference."""
+    watch.reference = np.array(position, dtype=float)
+    watch.reference_covariance = np.array(covariance, dtype=float)
+    watch.predicted = None
 
 
 def _own_fault(monitor: IntegrityMonitor, watch: Watch, m: SupportMeasurement) -> float:

@@ -101,13 +101,17 @@ class IntegrityMonitor:
         )
 
     def _motion(self, support: SupportMeasurement, state: StationState) -> Innovation | None:
+        """The fix against the support's motion reference (its last trusted fix, or where the
+        formation placed it, carried by the moves commanded since)."""
         watch = self.watch(support.name)
         watch.motion_detectable_m = None
-        previous = state.yhat.get(support.name)
-        if watch.covariance is None or previous is None:
+        if watch.reference is None or watch.reference_covariance is None:
             return None
         moved = state.last_support_command.get(support.name, np.zeros(3))
-        found = motion_innovation(support, previous, moved, watch.covariance, self.motion_sigma_m)
+        watch.predicted = watch.reference + moved  # where the reference went, this cycle
+        found = motion_innovation(
+            support, watch.reference, moved, watch.reference_covariance, self.motion_sigma_m
+        )
         if found is not None and self.fault_detectable > 0:  # its bias widens the radii
             watch.motion_detectable_m = detectable_bias(found.covariance, self.detectable)
         return found

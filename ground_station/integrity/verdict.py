@@ -17,7 +17,10 @@ from ground_station.gnss_map import Change
 class Watch:
     """What the monitor carries for one support between cycles."""
 
-    covariance: np.ndarray | None = None  # of its estimate, for the motion test
+    covariance: np.ndarray | None = None  # of its estimate (its protection radius)
+    reference: np.ndarray | None = None  # the motion test's: the last trusted fix, ...
+    reference_covariance: np.ndarray | None = None
+    predicted: np.ndarray | None = None  # ... carried by this cycle's commanded move
     excluded: bool = False
     recent: dict[str, deque[float]] = field(default_factory=dict)  # each test's statistics
     consistent: int = 0  # cycles in a row under the suspect gate, while excluded

@@ -67,9 +67,18 @@ def _primed(along, names=("support-1",), **changes) -> tuple[IntegrityMonitor, S
     monitor = IntegrityMonitor(_settings(along, **changes), multicopter=False, voxel_m=1.0)
     state = StationState(np.zeros(3), {n: np.zeros(3) for n in names}, 1)
     for name in names:
-        monitor.watch(name).covariance = PREVIOUS.copy()
+        _at(monitor, state, name, np.zeros(3))
         state.last_support_command[name] = np.array([0.3, 0.0, 0.0])
     return monitor, state
+
+
+def _at(monitor, state, name, position):
+    """The support's estimate and its motion test's reference at ``position`` (what the
+    monitor's settling after a fusion would leave), with the reference's covariance."""
+    watch = monitor.watch(name)
+    watch.reference, watch.reference_covariance = np.array(position, float), PREVIOUS.copy()
+    watch.covariance = PREVIOUS.copy()
+    state.yhat[name] = np.array(position, float)
 
 
 def _motion_statistic_by_hand(bias: np.ndarray) -> float:
@@ -107,7 +116,7 @@ def test_a_smaller_bias_is_excluded_once_two_cycles_sum_past_their_gate(along):
     first = monitor.check([_support("support-1", np.array([0.3, 0, 0]) + bias)], state)
     assert not first.excluded and "support-1" in first.withheld
     state.last_support_command["support-1"] = np.zeros(3)  # a withheld support: dead-reckoned
-    state.yhat["support-1"] = np.array([0.3, 0.0, 0.0])
+    _at(monitor, state, "support-1", [0.3, 0.0, 0.0])
     second = monitor.check([_support("support-1", np.array([0.3, 0, 0]) + bias)], state)
     assert second.excluded == {"support-1"}
 
@@ -154,11 +163,11 @@ def _excluded_then_quiet(along, moved_m: float) -> list[str]:
     assert monitor.check([_support("support-1", big)], state).excluded == {"support-1"}
     state.last_support_command["support-1"] = np.zeros(3)
     here = np.array([0.3, 0.0, 0.0])
-    state.yhat["support-1"] = here
+    _at(monitor, state, "support-1", here)
     for _ in range(3):  # still biased, here, as long as it takes to be restored
         monitor.check([_support("support-1", here + [2.2, 0, 0])], state)
     there = here + [moved_m, 0.0, 0.0]
-    state.yhat["support-1"] = there
+    _at(monitor, state, "support-1", there)
     kinds = []
     for _ in range(3):  # the fix is back where the support is
         verdict = monitor.check([_support("support-1", there)], state)
@@ -189,10 +198,10 @@ def test_a_bias_that_follows_its_support_is_its_receivers_and_g_forgets_it(along
         support = _support("support-1", position + glitch, work - position)
         verdict = monitor.check([support], state)
         if verdict.excluded:
-            state.yhat["support-1"] = position  # placed by the formation
+            _at(monitor, state, "support-1", position)  # placed by the formation
             events = list(monitor.settle([support], state, _blind(), verdict).events)
             monitor.learn_excluded(g, [support], state.yhat, events)
-        state.yhat["support-1"] = position
+        _at(monitor, state, "support-1", position)
         state.last_support_command["support-1"] = np.array([1.0, 0.0, 0.0])
         if any(e.kind == "receiver" for e in events):
             break
