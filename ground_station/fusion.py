@@ -28,6 +28,7 @@ class SupportMeasurement:
     relative_m: np.ndarray | None
     sigma_relative_m2: np.ndarray | None
     reported_m2: np.ndarray | None = None  # the receiver's own accuracy (GPS_RAW_INT)
+    belief_m: np.ndarray | None = None  # where its autopilot believes it is (LOCAL_POSITION_NED)
 
     @property
     def sigma_gnss_tested_m2(self) -> np.ndarray | None:

@@ -50,6 +50,7 @@ class SupportReport:
     reported: np.ndarray | None = None
     fix_age_s: float = 0.0
     relative_age_s: float = 0.0
+    belief: np.ndarray | None = None  # where its autopilot believes it is (ENU), this step
 
 
 class Sample(Protocol):
@@ -61,6 +62,7 @@ class Sample(Protocol):
     target: Any | None
     gps_age_s: float
     target_age_s: float
+    belief: Any | None
 
 
 def reports_from_messages(samples: Sequence[Sample], frame: GeodeticFrame) -> list[SupportReport]:
@@ -82,9 +84,18 @@ def reports_from_messages(samples: Sequence[Sample], frame: GeodeticFrame) -> li
                 reported,
                 sample.gps_age_s if fix is not None else 0.0,
                 sample.target_age_s if relative is not None else 0.0,
+                _belief(sample.belief),
             )
         )
     return reports
+
+
+def _belief(message: Any | None) -> np.ndarray | None:
+    """LOCAL_POSITION_NED as ENU (None where missing or not finite)."""
+    if message is None:
+        return None
+    belief = ned_to_enu(np.array([message.x, message.y, message.z], dtype=float))
+    return belief if np.all(np.isfinite(belief)) else None
 
 
 def plausible_fix(fix: np.ndarray | None, world: KnownWorld) -> bool:
@@ -124,7 +135,13 @@ def localize(values: Sequence[SupportReport], world: KnownWorld) -> list[Support
         fix = v.fix if sigma_gnss is not None else None
         measurements.append(
             SupportMeasurement(
-                v.name, fix, sigma_gnss, v.relative, sigma_relative_of.get(v.name), v.reported
+                v.name,
+                fix,
+                sigma_gnss,
+                v.relative,
+                sigma_relative_of.get(v.name),
+                v.reported,
+                v.belief,
             )
         )
     return measurements

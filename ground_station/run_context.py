@@ -69,7 +69,7 @@ def build_run_context(
         planner,
         inspections,
         route_map(world, sigma0) if inspections else None,
-        _monitor(scn),
+        _monitor(world),
     )
     state = StationState(
         xhat=waypoints["work"][0].copy(),
@@ -79,12 +79,14 @@ def build_run_context(
     return context, state
 
 
-def _monitor(scenario: Scenario) -> IntegrityMonitor | None:
+def _monitor(world: KnownWorld) -> IntegrityMonitor | None:
     """The integrity monitor where the scenario has it on."""
+    scenario = world.scenario
     if not scenario.integrity.enabled:
         return None
     multicopter = scenario.vehicle.dynamics == "multicopter"
-    return IntegrityMonitor(scenario.integrity, multicopter, scenario.map.voxel_size_m)
+    voxel_m = scenario.map.voxel_size_m
+    return IntegrityMonitor(scenario.integrity, multicopter, voxel_m, world.camera.covariance)
 
 
 def require_known_world(world: KnownWorld) -> KnownWorld:

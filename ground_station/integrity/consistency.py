@@ -17,7 +17,7 @@ excluded for noise it has announced.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,9 +63,17 @@ def motion_innovation(
 
 class Formation:
     """The contributing supports' information (Sigma_n^-1 and Sigma_n^-1 mu_n), computed once
-    a cycle, for estimates of the work UAV from any subset of them."""
+    a cycle, for estimates of the work UAV from any subset of them. With ``camera`` (Sigma_r
+    of a relative vector), a support's test takes its camera's covariance at the relative
+    vector the others predict where that is the larger: Sigma_r at the measured vector is
+    smallest exactly when the measured range came out short."""
 
-    def __init__(self, measurements: Sequence[SupportMeasurement]) -> None:
+    def __init__(
+        self,
+        measurements: Sequence[SupportMeasurement],
+        camera: Callable[[np.ndarray], np.ndarray] | None = None,
+    ) -> None:
+        self.camera = camera
         self.members = {m.name: m for m in measurements if m.contributes}
         self.sigma = {name: _tested_sigma(m) for name, m in self.members.items()}
         self.information = {name: inverse3(self.sigma[name]) for name in self.members}
@@ -91,7 +99,13 @@ class Formation:
         if found is None:
             return None
         position, covariance = found
-        return Innovation(support.mu - position, self.sigma[name] + covariance)
+        sigma = self.sigma[name]
+        if self.camera is not None and support.sigma_relative_m2 is not None:
+            assert support.fix_m is not None
+            predicted = self.camera(position - support.fix_m)
+            if np.trace(predicted) > np.trace(support.sigma_relative_m2):
+                sigma = sigma - support.sigma_relative_m2 + predicted
+        return Innovation(support.mu - position, sigma + covariance)
 
 
 def _tested_sigma(support: SupportMeasurement) -> np.ndarray:

@@ -22,7 +22,7 @@ they say its receiver lies, restored once they say it does not.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -46,8 +46,15 @@ class IntegrityMonitor:
     """Tests every support's fix each cycle (:meth:`check`) and keeps each one's covariance
     and state (:meth:`settle`, after the fusion)."""
 
-    def __init__(self, settings: IntegritySettings, multicopter: bool, voxel_m: float) -> None:
+    def __init__(
+        self,
+        settings: IntegritySettings,
+        multicopter: bool,
+        voxel_m: float,
+        camera: Callable[[np.ndarray], np.ndarray] | None = None,
+    ) -> None:
         self.settings = settings
+        self.camera = camera  # Sigma_r of a relative vector (the formation test's)
         self.voxel_m = voxel_m  # G's resolution: a place finer than this is one place
         self.motion_sigma_m = (
             settings.motion_sigma_multicopter_m if multicopter else settings.motion_sigma_m
@@ -107,7 +114,7 @@ class IntegrityMonitor:
         watch.motion_detectable_m = None
         if watch.reference is None or watch.reference_covariance is None:
             return None
-        moved = state.last_support_command.get(support.name, np.zeros(3))
+        moved = _moved(support, state)
         watch.predicted = watch.reference + moved  # where the reference went, this cycle
         found = motion_innovation(
             support, watch.reference, moved, watch.reference_covariance, self.motion_sigma_m
@@ -124,7 +131,7 @@ class IntegrityMonitor:
         supports it cannot tell apart. A support not trusted is judged against the trusted;
         with three or more trusted, where several exceed, the largest is blamed if the others
         then agree; two trusted test only each other, a pair that cannot say which lies."""
-        formation = self.formation = Formation(measurements)  # settle reuses it
+        formation = self.formation = Formation(measurements, self.camera)  # settle reuses it
         contributing = list(formation.members)
         trusted = [
             name
@@ -258,3 +265,14 @@ def fault_noncentrality(settings: IntegritySettings) -> float:
         return 0.0
     allowed = min(0.5, settings.missed_detection / settings.fault_prior)
     return detectable_noncentrality(settings.false_alarm, allowed)
+
+
+def _moved(support: SupportMeasurement, state: StationState) -> np.ndarray:
+    """How far the support moved since the last cycle: as its autopilot reports it (its
+    belief now, less the estimate it was sent then, which reset its belief), or, without that
+    report, as it was commanded. A vehicle that did not fly its command (a setpoint its fence
+    refused) moved as it reports, not as it was told."""
+    sent = state.yhat.get(support.name)
+    if support.belief_m is not None and sent is not None:
+        return support.belief_m - sent
+    return state.last_support_command.get(support.name, np.zeros(3))

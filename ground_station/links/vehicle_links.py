@@ -47,6 +47,7 @@ class SupportSample:
     target: Any | None
     gps_age_s: float = 0.0
     target_age_s: float = 0.0
+    belief: Any | None = None  # LOCAL_POSITION_NED of the cycle's own step (lockstep), if any
 
 
 class StationError(RuntimeError):
@@ -224,7 +225,8 @@ class VehicleLinks:
         return age if age <= MAX_AGE_STEPS * self.clock.step_s else None
 
     def support_samples(self) -> list[SupportSample]:
-        """Each support's GPS_RAW_INT and LANDING_TARGET for this cycle with their ages, for
+        """Each support's GPS_RAW_INT and LANDING_TARGET for this cycle with their ages, and
+        its autopilot's belief (LOCAL_POSITION_NED) where it is of this cycle's own step, for
         every support not lost."""
         samples = []
         for name, view in self.views.items():
@@ -232,6 +234,7 @@ class VehicleLinks:
                 continue
             gps, target = self.current(name, "GPS_RAW_INT"), self.current(name, "LANDING_TARGET")
             gps_age, target_age = self.age_s(name, gps), self.age_s(name, target)
+            belief = self.current(name, "LOCAL_POSITION_NED")
             samples.append(
                 SupportSample(
                     name,
@@ -239,6 +242,7 @@ class VehicleLinks:
                     target if target_age is not None else None,
                     gps_age or 0.0,
                     target_age or 0.0,
+                    belief if self.age_s(name, belief) == 0.0 else None,
                 )
             )
         return samples

@@ -273,3 +273,29 @@ def test_a_receiver_that_reports_itself_poor_widens_its_own_tests(along):
     by_hand = 0.8**2 / (reported[0, 0] + PREVIOUS[0, 0] + Q**2)
     assert wide == pytest.approx(by_hand, rel=1e-12) and wide < plain["motion"]
     assert not verdict.excluded  # the 0.8 m it may be off is within what it said
+
+
+def test_a_vehicle_that_did_not_fly_its_command_is_tested_where_its_autopilot_says_it_is(along):
+    """Its setpoint refused, it held: the fix where it held, against the 0.3 m it was told."""
+    monitor, state = _primed(along, sustain_cycles=1)
+    held = np.zeros(3)
+    told = monitor.check([_support("support-1", held)], state).statistics["support-1"]["motion"]
+    assert told == pytest.approx(_motion_statistic_by_hand(np.array([-0.3, 0.0, 0.0])))
+    monitor, state = _primed(along, sustain_cycles=1)
+    reported = dataclasses.replace(_support("support-1", held), belief_m=held)  # it says: here
+    verdict = monitor.check([reported], state)
+    assert verdict.statistics["support-1"]["motion"] == pytest.approx(0.0)
+
+
+def test_the_formation_test_takes_the_camera_at_the_predicted_range_where_that_is_wider(along):
+    wide = np.diag([0.09, 0.0025, 0.0025])  # the camera at the range the others predict
+    monitor = IntegrityMonitor(
+        _settings(along), multicopter=False, voxel_m=1.0, camera=lambda relative: wide
+    )
+    _, state, supports = _formation(biased=1, count=3, along=along)
+    verdict = monitor.check(supports, state)
+    nu = supports[1].mu - (supports[0].mu + supports[2].mu) / 2
+    s = SIGMA_GNSS + wide + (SIGMA_GNSS + SIGMA_R) / 2  # its own camera widened; the others'
+    assert verdict.statistics["support-2"]["formation"] == pytest.approx(
+        float(nu @ np.linalg.solve(s, nu)), rel=1e-12
+    )
