@@ -234,7 +234,7 @@ class VehicleLinks:
                 continue
             gps, target = self.current(name, "GPS_RAW_INT"), self.current(name, "LANDING_TARGET")
             gps_age, target_age = self.age_s(name, gps), self.age_s(name, target)
-            belief = self.current(name, "LOCAL_POSITION_NED")
+            belief = self._belief_of_this_step(name)
             samples.append(
                 SupportSample(
                     name,
@@ -242,10 +242,18 @@ class VehicleLinks:
                     target if target_age is not None else None,
                     gps_age or 0.0,
                     target_age or 0.0,
-                    belief if self.age_s(name, belief) == 0.0 else None,
+                    belief,
                 )
             )
         return samples
+
+    def _belief_of_this_step(self, name: str) -> Any | None:
+        """The vehicle's LOCAL_POSITION_NED of this very step (lockstep only: its boot time is
+        the run's simulated time; in real time, None)."""
+        belief = self.views[name].latest.get("LOCAL_POSITION_NED")
+        if not self.clock.lockstep or belief is None:
+            return None
+        return belief if int(belief.time_boot_ms) == round(self.clock.time_s * 1000) else None
 
     # -- who is there -----------------------------------------------------------------------
     def supervise(self, link_loss_s: float, rejoin_within_s: float) -> list[str]:
