@@ -118,16 +118,30 @@ def test_errors_steps_in_a_zone_and_g_follow_the_metrics_and_snapshots(replayed)
     assert np.allclose(voxels["VoxelGridMap:values"][-1], final[tuple(changed.T)], atol=1e-6)
 
 
+LIVE = """
+import sys
+from pathlib import Path
+from mission.procs.numerics import prepare_numerics
+prepare_numerics()  # as `mission run --view` computes (this test's own process is not pinned)
+from mission.config.scenario import load_scenario
+from mission.runs.orchestrator import RunOptions, run_mission
+from mission.viewer.live import LiveView
+scenario_file, out, save = sys.argv[1:4]
+scenario = load_scenario(scenario_file)
+live = LiveView(Path(out), scenario, None, save=Path(save))
+run_mission(RunOptions(scenario_file, "ac", 0, Path(out)), scenario, live)
+"""
+
+
 def test_the_live_view_records_what_the_replay_does(replayed, tmp_path):
     """A live run (streamed as it flies) and the replay of it hold the same rows."""
-    from mission.runs.orchestrator import RunOptions, run_mission
-    from mission.viewer.live import LiveView
+    import subprocess
+    import sys
 
     _, scenario_file, _ = replayed
-    scenario = load_scenario(str(scenario_file))
     out = tmp_path / "live-run"
-    live = LiveView(out, scenario, None, save=tmp_path / "live.rrd")
-    run_mission(RunOptions(str(scenario_file), "ac", 0, out), scenario, live)
+    live = [sys.executable, "-c", LIVE, str(scenario_file), str(out), str(tmp_path / "live.rrd")]
+    subprocess.run(live, check=True, capture_output=True, timeout=600)
     assert mission("view", str(out), "--save", str(tmp_path / "replay.rrd")).returncode == 0
     streamed, replay = read_rrd(tmp_path / "live.rrd"), read_rrd(tmp_path / "replay.rrd")
     assert set(streamed) == set(replay)
