@@ -7,6 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from mission.analysis.lockstep import integrity_note
 from mission.commands.common import (
     add_realtime_arguments,
     add_scenario_argument,
@@ -17,7 +18,6 @@ from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import check_seed
 from mission.procs.outputs import check_output_dir
-from mission.runs.lockstep_check import integrity_note
 from mission.runs.stall import DEFAULT_STALL_S
 
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
+from mission.analysis.lockstep import lockstep_integrity
 from mission.analysis.run_metrics import run_metrics
 from mission.config.errors import InputError
 from mission.config.settings import Scenario
@@ -34,7 +35,6 @@ from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
 from mission.procs.provenance import run_provenance
 from mission.procs.stopping import stop_processes
-from mission.runs.lockstep_check import lockstep_integrity
 from mission.runs.stall import DEFAULT_STALL_S, StallWatch
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")

@@ -58,7 +58,7 @@ def conclude(run: StudyRun, run_dir: Path, status: int, node: str, keep: Keep) -
     """The finished run's summary with the study's block added (also in its summary.json),
     or None if it failed; files beyond ``keep`` are removed."""
     summary = _read_summary(run_dir)
-    if status != 0 or summary is None:
+    if status != 0 or summary is None or not exact(summary):
         return None
     summary["study"] = {
         "run_key": run.key,
@@ -76,7 +76,15 @@ def finished_summary(run: StudyRun, run_dir: Path) -> dict | None:
     summary = _read_summary(run_dir)
     if summary is None or (summary.get("study") or {}).get("run_key") != run.key:
         return None
-    return summary
+    return summary if exact(summary) else None
+
+
+def exact(summary: dict[str, Any]) -> bool:
+    """Whether a run kept its lockstep (no wall-clock timeout fired:
+    :mod:`mission.analysis.lockstep`), so that it reproduces; a real-time run has no
+    such block. A study counts a run that did not as failed, and makes it again."""
+    lockstep = summary.get("lockstep")
+    return not isinstance(lockstep, dict) or lockstep.get("exact", True) is not False
 
 
 def trim(run_dir: Path, keep: Keep) -> None:

@@ -8,6 +8,7 @@ again skips what is done and ends with the same results and report.
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from dataclasses import dataclass
@@ -102,9 +103,7 @@ def run_study(
         name = run.folder if len(spec.points) == 1 else f"{run.folder} [{point}]"
         if summary is None:
             failed.append(run.folder)
-            bar.advance(f"{name}: FAILED (see {runs_dir / run.folder})")
-        else:
-            bar.advance(f"{name}: {_one_line(summary)}")
+        bar.advance(f"{name}: {_one_line(summary, runs_dir / run.folder)}")
         report = time.monotonic() - last_report > REPORT_EVERY_S
         outputs.write(summaries, len(failed), report)
         last_report = time.monotonic() if report else last_report
@@ -179,7 +178,22 @@ def rewrite_report(spec: StudySpec, out_dir: Path) -> int:
     return len(rows)
 
 
-def _one_line(summary: dict[str, Any]) -> str:
+def _why_failed(run_dir: Path) -> str:
+    """': not exact lockstep ...' where the run finished but its lockstep did not hold."""
+    from mission.analysis.lockstep import integrity_note
+
+    try:
+        summary = json.loads((run_dir / "summary.json").read_text())
+    except (OSError, ValueError):
+        return ""
+    note = integrity_note(summary) if isinstance(summary, dict) else ""
+    return f": {note.removeprefix('; ')}" if note else ""
+
+
+def _one_line(summary: dict[str, Any] | None, run_dir: Path) -> str:
+    """A finished run's progress line: how it ended, or why it failed and where to look."""
+    if summary is None:
+        return f"FAILED{_why_failed(run_dir)} (see {run_dir})"
     done = (
         f"completed at {summary['completion_time_s']:.1f} s"
         if summary["completed"]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mission.runs.lockstep_check import integrity_note, lockstep_integrity
+from mission.analysis.lockstep import integrity_note, lockstep_integrity
 
 LINE = (
     "{name}: 515 steps to t=257.5 s; link in 1565 packets / 536 datagrams, bad 0 datagrams "

@@ -46,9 +46,10 @@ class FakeEngine:
     description = "fake engine"
     cores = 1
 
-    def __init__(self, fail_seed: int | None = None) -> None:
+    def __init__(self, fail_seed: int | None = None, inexact_seed: int | None = None) -> None:
         self.ran: list[str] = []
         self.fail_seed = fail_seed
+        self.inexact_seed = inexact_seed  # its run's lockstep did not hold
 
     def run(self, runs, runs_dir, keep, done) -> None:
         for run in runs:
@@ -56,7 +57,10 @@ class FakeEngine:
             execute.prepare(run, folder)
             self.ran.append(run.folder)
             if run.seed != self.fail_seed:
-                (folder / "summary.json").write_text(json.dumps(_summary(run)))
+                summary = _summary(run)
+                if run.seed == self.inexact_seed:
+                    summary["lockstep"] = {"exact": False, "auto_steps": 4}
+                (folder / "summary.json").write_text(json.dumps(summary))
             status = 0 if run.seed != self.fail_seed else 1
             done(run, execute.conclude(run, folder, status, "node-a", keep), 1.0)
 
@@ -100,6 +104,16 @@ def test_a_failed_run_is_reported_and_runs_again_next_time(tmp_path):
     engine = FakeEngine()
     run_study(_spec(), tmp_path, engine, progress=io.StringIO())
     assert len(engine.ran) == 4 and all("-1-" in name for name in engine.ran)
+
+
+def test_a_run_whose_lockstep_did_not_hold_is_failed_and_made_again(tmp_path):
+    progress = io.StringIO()
+    outcome = run_study(_spec(), tmp_path, FakeEngine(inexact_seed=2), progress=progress)
+    assert len(outcome.failed) == 4 and outcome.finished == 8
+    assert "FAILED: NOT exact lockstep (auto steps 4): it may not reproduce" in progress.getvalue()
+    engine = FakeEngine()
+    run_study(_spec(), tmp_path, engine, progress=io.StringIO())
+    assert sorted(folder.split("-")[2] for folder in engine.ran) == ["2"] * 4
 
 
 def test_studies_sharing_a_runs_folder_make_a_common_run_once(tmp_path):
