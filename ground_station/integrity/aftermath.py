@@ -1,5 +1,5 @@
-"""What the integrity monitor does after the fusion: the withheld supports' navigation (the
-formation's estimate less the support's sighting, else the fusion's dead reckoning), each
+"""What the integrity monitor does after the fusion: the withheld supports' navigation (an
+excluded one's: the formation's estimate less its sighting; else the fusion's dead reckoning), each
 estimate's covariance and protection radius (:mod:`~.protection`), how far an excluded support
 has carried its bias (past ``receiver_travel_m``: its receiver's), and what the excluded teach
 G (taken back from a receiver)."""
@@ -100,13 +100,15 @@ def _navigate(
     withheld: bool,
     work: tuple[np.ndarray | None, float],
 ) -> None:
-    """The support's estimate where the monitor decides it (withheld and seeing the work
-    UAV: the formation's, ``work`` being xhat's covariance, None when blind, and its fault
-    term), its covariance, and the undetected bias it may carry."""
+    """The support's estimate where the monitor decides it (excluded and seeing the work UAV:
+    the formation's, ``work`` being xhat's covariance, None when blind, and its fault term; a
+    support only withheld this cycle, suspect or ambiguous, stays dead-reckoned from its last
+    trusted fix, as its sighting may be what is wrong), its covariance, and the undetected
+    bias it may carry."""
     watch = monitor.watch(m.name)
     xhat_covariance, fault_x = work
     drift = monitor.motion_sigma_m**2 * np.eye(3)
-    if withheld and xhat_covariance is not None and m.relative_m is not None:
+    if withheld and watch.excluded and xhat_covariance is not None and m.relative_m is not None:
         assert fusion.xhat is not None and m.sigma_relative_m2 is not None
         state.yhat[m.name] = fusion.xhat - m.relative_m
         watch.covariance = xhat_covariance + m.sigma_relative_m2
