@@ -105,7 +105,8 @@ def compare_rows(
             if is_timing(column):
                 continue
             if column not in mine:
-                found.differences.append((label, column, _cell(value), "(no such column)"))
+                if value is not None:  # an empty cell: the metric this run does not have
+                    found.differences.append((label, column, _cell(value), "(no such column)"))
             elif mine[column] != value:
                 found.differences.append((label, column, _cell(value), _cell(mine[column])))
         found.only_today |= {c for c in mine if c not in committed and not is_timing(c)}
