@@ -54,7 +54,7 @@ class StationConfig:
     tlog_path: Path | None = None  # default: out_dir / "gcs.tlog"
     signing_key: bytes | None = None  # MAVLink 2 signing secret
     link: LinkSettings = field(default_factory=LinkSettings)  # loss and delay of what we send
-    step_timeout_wall_s: float = 5.0
+    step_timeout_wall_s: float = 15.0  # a vehicle's step waited for (then it is late)
     late_grace_wall_s: float = 0.05  # lockstep: how long a late vehicle is waited for
     link_loss_s: float = 3.0  # simulated seconds of silence before a vehicle counts as lost
     link_loss_wall_s: float = 2.0  # real time: and at least this much wall time (a busy CPU)

@@ -59,7 +59,9 @@ def test_a_run_on_a_loaded_machine_decides_as_on_an_idle_one(short_run, tmp_path
 
 
 def test_a_vehicle_frozen_past_the_timeouts_makes_the_run_say_it_is_not_exact(short_run, tmp_path):
-    _, scenario = short_run
+    _, short = short_run
+    scenario = tmp_path / "impatient.yaml"  # vehicles that step alone after 1 s, not 10
+    scenario.write_text(f"extends: {short}\nvehicle: {{lockstep_timeout_wall_s: 1.0}}\n")
     out = tmp_path / "frozen"
     command = [sys.executable, "-m", "mission", "run", str(scenario), "--out", str(out)]
     run = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, text=True)

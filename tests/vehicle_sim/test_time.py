@@ -92,19 +92,25 @@ def test_a_waiting_vehicle_answers_a_new_peer_at_once():
     assert waited < 0.3
 
 
-def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout():
+def _short_waits(tmp_path, timeout_s: float):
+    """Along with the truth waited for ``timeout_s`` (the default's 10 s would make the test
+    wait that long)."""
+    path = tmp_path / "short-waits.yaml"
+    path.write_text(f"extends: along\nvehicle: {{truth_timeout_wall_s: {timeout_s}}}\n")
+    return path
+
+
+def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout(tmp_path):
     """In lockstep a support publishes a step once the work UAV's truth of that step is there:
-    late truth is waited for; missing truth, for ``vehicle.truth_timeout_wall_s`` (2 s), after
+    late truth is waited for; missing truth, for ``vehicle.truth_timeout_wall_s`` (here 2 s), after
     which the camera sees the last known position (counted as an extrapolated truth).
     Truth samples are keyed by simulated microseconds in lockstep."""
     import numpy as np
 
-    from mission.config.scenario import load_scenario
     from vehicle_sim.truth_link import TruthSender
 
-    timeout = load_scenario("along").vehicle.truth_timeout_wall_s
-    assert timeout == 2.0
-    with vehicle_process("support-1") as support:
+    timeout = 2.0
+    with vehicle_process("support-1", scenario=str(_short_waits(tmp_path, timeout))) as support:
         assert support.truth_port is not None
         truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
         client = MavClient(support.address)
@@ -127,17 +133,16 @@ def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout()
     assert "truth waits timed out 1, truth interpolated 0, extrapolated 1" in report
 
 
-def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has():
+def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has(tmp_path):
     """Truth samples come in order: once a later one is there, the truth of the step was lost
     or came before the support listened (a support restarted into a running mission), and
     waiting for it would only stall the support for the timeout at every such step."""
     import numpy as np
 
-    from mission.config.scenario import load_scenario
     from vehicle_sim.truth_link import TruthSender
 
-    timeout = load_scenario("along").vehicle.truth_timeout_wall_s
-    with vehicle_process("support-1") as support:
+    timeout = 2.0
+    with vehicle_process("support-1", scenario=str(_short_waits(tmp_path, timeout))) as support:
         assert support.truth_port is not None
         truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
         client = MavClient(support.address)
