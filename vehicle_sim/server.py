@@ -15,7 +15,9 @@ Stepping lives in :class:`~vehicle_sim.vehicle.Vehicle`; this module only decide
 Each step ends with SYSTEM_TIME (the step marker the ground station waits for). A support's
 camera sample of a step needs the work UAV's truth at the same physical time
 (:mod:`vehicle_sim.truth_link`); it is waited for briefly: in lockstep up to
-``truth_timeout_wall_s``, in real time up to one step's wall time (then interpolated).
+``truth_timeout_wall_s``, in real time up to one step's wall time (then interpolated). In
+lockstep, after a wait that timed out, none is waited for again until a newer truth arrives
+(a frozen work UAV would otherwise cost every step the timeout).
 """
 
 from __future__ import annotations
@@ -93,6 +95,7 @@ class VehicleServer:
         self._origin_unix = 0.0  # the same instant on the host's wall clock (truth channel)
         self._last_idle_heartbeat = -math.inf
         self._pending_deadline: float | None = None
+        self._gave_up_at: int | None = None  # the newest truth when a wait last timed out
         self._parent = os.getppid()
         self._batch: list[Any] | None = None
         # The last step's messages, for a repeated tick: encoded afresh when asked again, since
@@ -311,7 +314,9 @@ class VehicleServer:
             return True
         self.truth_receiver.drain()
         truth = self.truth_receiver.exact(physical_usec)
-        if truth is None and self.truth_receiver.may_still_come(physical_usec):
+        receiver = self.truth_receiver
+        silent = self._gave_up_at is not None and self._gave_up_at == receiver.newest_usec()
+        if truth is None and receiver.may_still_come(physical_usec) and not silent:
             self._pending_deadline = now + self._truth_wait_wall_s()
             return False
         self._publish_step(
@@ -329,6 +334,8 @@ class VehicleServer:
             return False
         if truth is None:  # a later truth came instead, or none in time
             self.stats.truth_waits_timed_out += int(timed_out)
+            if timed_out and self.clock.lockstep:  # not waited for again until the work UAV
+                self._gave_up_at = receiver.newest_usec()  # is heard from (its 10 s a step)
             truth = receiver.estimate(physical_usec)
         self._pending_deadline = None
         self._publish_step(truth)

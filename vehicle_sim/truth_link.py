@@ -118,6 +118,10 @@ class TruthReceiver:
         of it at or after this time."""
         return bool(self.samples) and max(self.samples) < time_usec
 
+    def newest_usec(self) -> int | None:
+        """The time of the newest truth sample (None before any)."""
+        return max(self.samples) if self.samples else None
+
     def exact(self, time_usec: int) -> np.ndarray | None:
         """The truth at exactly this time, if it has arrived."""
         return self.samples.get(time_usec)

@@ -223,3 +223,28 @@ def test_in_real_time_a_support_interpolates_the_truth_and_answers_timesync_at_o
     rates = np.diff(clock) / np.diff(sent)
     np.testing.assert_allclose(rates, 10.0, rtol=0.1)
     assert np.any((clock / 1e9) % 0.5 > 0.05)
+
+
+def test_after_a_wait_that_timed_out_a_silent_work_uav_is_not_waited_for_again(tmp_path):
+    """A frozen work UAV: the first step waits the timeout, the next ones do not, until a
+    truth arrives again."""
+    import numpy as np
+
+    from vehicle_sim.truth_link import TruthSender
+
+    timeout = 1.0
+    with vehicle_process("support-1", scenario=str(_short_waits(tmp_path, timeout))) as support:
+        truth = TruthSender(1, [("127.0.0.1", support.truth_port)])
+        client = MavClient(support.address)
+        work = np.array([0.0, -4.0, 7.0])
+        truth.publish(work, 500_000)
+        assert _step_marker_after(client, 500) < 0.5 * timeout
+        assert timeout <= _step_marker_after(client, 1000) < timeout + 1.0  # waited, in vain
+        assert _step_marker_after(client, 1500) < 0.5 * timeout  # not again
+        truth.publish(work, 2_000_000)  # heard from again
+        assert _step_marker_after(client, 2000) < 0.5 * timeout  # its own truth: no wait
+        assert timeout <= _step_marker_after(client, 2500) < timeout + 1.0  # waited again
+        truth.close()
+        client.close()
+        report = support.stop()
+    assert "truth waits timed out 2" in report
