@@ -22,16 +22,23 @@ from mission.procs.provenance import code_identity, environment, last_commit_of
 PROVENANCE_FILE = "provenance.json"
 
 
+def made_now(name: str, code: str) -> dict[str, Any]:
+    """What a study made now with the code whose version is ``code`` says of its making: the
+    commit, the packages, the machine (read once a study: git and the numerics cost tens of
+    milliseconds)."""
+    return {"study": name, **code_identity(), "code_version": code, **environment()}
+
+
 def study_provenance(
-    name: str, code: str, canary: dict[str, Any], run_numerics: dict[str, Any] | None
+    made: dict[str, Any], canary: dict[str, Any], run_numerics: dict[str, Any] | None
 ) -> dict[str, Any]:
-    """The provenance of a study made now with the code whose version is ``code``; the
-    machine's numerics are ``run_numerics`` where a run said what it computed with (its
-    summary's), else this process's."""
-    made = {"study": name, **code_identity(), "code_version": code, **environment()}
+    """The provenance of a study (``made``: :func:`made_now`); the machine's numerics are
+    ``run_numerics`` where a run said what it computed with (its summary's), else this
+    process's."""
+    provenance = json.loads(json.dumps(made))  # a copy
     if run_numerics:
-        made["machine"]["numerics"] = run_numerics
-    return {**made, "canary": canary, "historical": None}
+        provenance["machine"]["numerics"] = run_numerics
+    return {**provenance, "canary": canary, "historical": None}
 
 
 def write_provenance(out_dir: Path, provenance: dict[str, Any]) -> None:

@@ -20,7 +20,12 @@ from mission.procs.machine_speed import REFERENCE_LOOP_S, python_loop_s
 from mission.studies.canary import canary_record, canary_runs
 from mission.studies.execute import Keep, finished_summary
 from mission.studies.local_engine import Done
-from mission.studies.provenance_file import read_provenance, study_provenance, write_provenance
+from mission.studies.provenance_file import (
+    made_now,
+    read_provenance,
+    study_provenance,
+    write_provenance,
+)
 from mission.studies.report import write_report
 from mission.studies.results import read_results_csv, result_row, results_csv
 from mission.studies.runkeys import StudyRun, code_version, study_runs
@@ -148,6 +153,7 @@ class StudyOutputs:
     runs: list[StudyRun]
     canaries: list[StudyRun]
     code: str
+    made: dict[str, Any] | None = None  # made_now(), read at the first write
 
     def write(self, summaries: dict[StudyRun, dict[str, Any]], failed: int, report: bool) -> None:
         """results.csv and provenance.json; with ``report``, report.md too."""
@@ -159,7 +165,9 @@ class StudyOutputs:
             made = [summaries.get(run) for run in self.canaries]
             numerics = ((made[0] or {}).get("provenance") or {}).get("numerics")
             canary = canary_record(made)
-            provenance = study_provenance(spec.name, self.code, canary, numerics)
+            if self.made is None:
+                self.made = made_now(spec.name, self.code)
+            provenance = study_provenance(self.made, canary, numerics)
             write_provenance(self.out_dir, provenance)
         if report:
             write_report(self.out_dir, spec, rows, failed, provenance)
