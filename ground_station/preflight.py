@@ -3,6 +3,7 @@ mission protocol, then GUIDED and armed, each command acknowledged."""
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from pathlib import Path
@@ -17,6 +18,12 @@ from mission.link.waypoints import read_waypoints, row_position_enu
 from mission.world.frames import GeodeticFrame
 
 COMMAND_TIMEOUT_WALL_S = 5.0  # a command is repeated until acknowledged, this long at most
+# A mission message unanswered for this many lockstep retries is sent again: 0.2 s on a local
+# link, longer with its delay (the protocol's 1.5 s made an upload over a link losing 30 % take
+# a minute; MAVSDK suggests 0.5 s, less on one host), for MISSION_SILENCE_WALL_S (a vehicle that
+# answers nothing for that long has stopped answering).
+MISSION_REPLY_RETRIES = 10
+MISSION_SILENCE_WALL_S = 10.0
 
 
 def connect(links: VehicleLinks, timeout_wall_s: float) -> None:
@@ -37,13 +44,20 @@ def connect(links: VehicleLinks, timeout_wall_s: float) -> None:
 
 
 def upload_missions(
-    links: VehicleLinks, waypoints_dir: Path, frame: GeodeticFrame
+    links: VehicleLinks, waypoints_dir: Path, frame: GeodeticFrame, retry_wall_s: float
 ) -> dict[str, np.ndarray]:
     """Upload each vehicle's waypoint file; return their waypoints (ENU, home excluded)."""
     waypoints = {}
     for view in links.views.values():
         rows = read_waypoints(waypoints_dir / f"{view.name}.waypoints")
-        client = MissionClient(links.queue, view.address, view.system_id, on_other=links.receive)
+        client = MissionClient(
+            links.queue,
+            view.address,
+            view.system_id,
+            timeout_s=(timeout_s := MISSION_REPLY_RETRIES * retry_wall_s),
+            retries=math.ceil(MISSION_SILENCE_WALL_S / timeout_s),
+            on_other=links.receive,
+        )
         client.on_sent = lambda packet: links.tlog.write(links.clock.time_usec, packet)
         try:
             result = client.upload([row.to_item() for row in rows])

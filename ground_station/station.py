@@ -137,7 +137,9 @@ class GroundStation:
                 self._helper.close()
                 self._helper = None
         connect(self.links, self.config.connect_timeout_wall_s)
-        waypoints = upload_missions(self.links, self.config.waypoints_dir, self.frame)
+        waypoints = upload_missions(
+            self.links, self.config.waypoints_dir, self.frame, self.timing.retry_wall_s
+        )
         arm_all(self.links, self.timing.retry_wall_s)
         config = self.config
         self.context, state = build_run_context(

@@ -31,7 +31,8 @@ from mission.procs.cli_common import (
     run_guarded,
 )
 from mission.world.model import World
-from vehicle_sim.server import ClockSettings, VehicleServer, install_signal_handlers
+from vehicle_sim.server import ClockSettings, VehicleServer
+from vehicle_sim.signals import install_signal_handlers
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 

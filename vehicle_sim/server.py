@@ -26,12 +26,9 @@ import contextlib
 import math
 import os
 import select
-import signal
-import socket
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -40,6 +37,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.link.mavlink_udp import Address, UdpEndpoint
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.procs.wall_grid import next_grid_instant
+from vehicle_sim.signals import signal_wakeup
 from vehicle_sim.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 
@@ -98,6 +96,8 @@ class VehicleServer:
         self._gave_up_at: int | None = None  # the newest truth when a wait last timed out
         self._parent = os.getppid()
         self._batch: list[Any] | None = None
+        self._step_events: list[Any] | None = None  # collecting what the vehicle says as it steps
+        self._said: list[Any] = []  # what the step said, sent with its telemetry
         # The last step's messages, for a repeated tick: encoded afresh when asked again, since
         # a signed link refuses a replayed packet (its signature timestamp must increase).
         self._last_step: list[Any] = []
@@ -110,9 +110,14 @@ class VehicleServer:
     def broadcast(self, message: Any) -> None:
         """Send a message to every peer that has talked to us and every --out address.
 
-        While a step is being published, messages are collected and leave together.
+        While a step is being published, messages are collected and leave together; what the
+        vehicle says while it steps (faults, parameters, contacts) leaves with that step's
+        telemetry, beside its marker, so that it is as reliable as the lockstep: a step whose
+        marker was lost is sent again, and carries it again.
         """
-        if self._batch is not None:
+        if self._step_events is not None:
+            self._step_events.append(message)
+        elif self._batch is not None:
             self._batch.append(message)
         else:
             self.endpoint.send(message, [*self.peers, *self.outs])
@@ -120,11 +125,13 @@ class VehicleServer:
     def _publish_step(self, truth: Any) -> None:
         """Publish the step's telemetry as one batch of datagrams."""
         assert self.vehicle is not None
-        self._batch = []
+        said, self._said, self._batch = self._said, [], []
         try:
             self.vehicle.publish(truth)
         finally:
-            batch, self._batch = self._batch, None
+            # What the step said goes just before the marker (SYSTEM_TIME, the last): in the
+            # marker's datagram, so that a marker received means they were received.
+            batch, self._batch = self._batch[:-1] + said + self._batch[-1:], None
             self.endpoint.send_many(batch, [*self.peers, *self.outs])
             self._last_step = batch
 
@@ -139,7 +146,7 @@ class VehicleServer:
         sources: list[Any] = [self.endpoint]
         if self.truth_receiver is not None:
             sources.append(self.truth_receiver)
-        with _signal_wakeup() as woken:  # a signal ends the wait at once, not at the timeout
+        with signal_wakeup() as woken:  # a signal ends the wait at once, not at the timeout
             sources.append(woken)
             self._serve(sources)
 
@@ -305,7 +312,11 @@ class VehicleServer:
         """One step; False if its publication waits for the work UAV's truth."""
         vehicle = self.vehicle
         assert vehicle is not None
-        vehicle.step(self._others_last_step())
+        self._step_events = []
+        try:
+            vehicle.step(self._others_last_step())
+        finally:
+            self._said, self._step_events = self._step_events, None
         physical_usec = self._physical_usec()
         if self.truth_sender is not None:
             self.truth_sender.publish(vehicle.kinematics.truth, physical_usec)
@@ -373,33 +384,3 @@ class VehicleServer:
             f"{beyond}, "
             f"steps resent {self.stats.resent_steps}"
         )
-
-
-@contextlib.contextmanager
-def _signal_wakeup() -> Iterator[socket.socket]:
-    """A socket that becomes readable when a signal arrives (signal.set_wakeup_fd); the
-    previous wakeup fd is restored after. Outside the main thread, one that never wakes."""
-    reader, writer = socket.socketpair()
-    reader.setblocking(False)
-    writer.setblocking(False)
-    try:
-        previous = signal.set_wakeup_fd(writer.fileno(), warn_on_full_buffer=False)
-    except ValueError:  # not the main thread
-        previous = None
-    try:
-        yield reader
-    finally:
-        if previous is not None:
-            signal.set_wakeup_fd(previous)
-        reader.close()
-        writer.close()
-
-
-def install_signal_handlers(stop: Callable[..., None], die_with_parent: bool) -> None:
-    """SIGTERM and SIGINT end the loop cleanly; optionally die with the parent (Linux)."""
-    signal.signal(signal.SIGTERM, stop)
-    signal.signal(signal.SIGINT, stop)
-    if die_with_parent:
-        from mission.procs.cli_common import die_with_parent as arrange
-
-        arrange()

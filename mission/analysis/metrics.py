@@ -82,6 +82,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     samples = _StepSamples()
     replies: list[TimesyncReply] = []
     chunks = StatusChunks()  # the ground station's long STATUSTEXTs
+    said: set[tuple[int, str]] = set()  # the vehicles' texts so far
     for message in messages:
         kind = message.get_type()
         t = round(message._timestamp - epoch, 3)
@@ -95,12 +96,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
             samples.stamp(source, int(message.time_unix_usec))
         elif kind == "STATUSTEXT" and source != GCS_SYSTEM_ID:
-            contact = _CONTACT.match(message.text)
-            if contact:
-                trace.contacts.append(_contact_event(source, contact))
-            event = parse_event(message.text, VehicleIdentity.from_system_id(source).name)
-            if event is not None:
-                trace.events.append(event)
+            _vehicle_said(trace, said, source, message.text)
         elif kind == "TIMESYNC" and source != GCS_SYSTEM_ID:
             received_ns = round(message._timestamp * 1e9 - epoch * 1e9)
             replies.append(TimesyncReply(source, message.tc1, message.ts1, received_ns))
@@ -131,6 +127,20 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             if trace.ticks or system in offsets:
                 into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
     return trace
+
+
+def _vehicle_said(trace: RunTrace, said: set[tuple[int, str]], source: int, text: str) -> None:
+    """A vehicle's contact or event, once: each names its time, so the same text again is a
+    copy (a step sent again carries what the vehicle said in it)."""
+    if (source, text) in said:
+        return
+    said.add((source, text))
+    contact = _CONTACT.match(text)
+    if contact:
+        trace.contacts.append(_contact_event(source, contact))
+    event = parse_event(text, VehicleIdentity.from_system_id(source).name)
+    if event is not None:
+        trace.events.append(event)
 
 
 def _station_said(trace: RunTrace, text: str, t: float) -> None:

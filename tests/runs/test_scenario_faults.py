@@ -115,3 +115,43 @@ def _lines(path: Path) -> list[str]:
         return path.read_text().splitlines()
     except OSError:
         return []
+
+
+LOSSY_FAULTS = """extends: along
+name: lossy-faults
+run:
+  timeout_s: 10
+faults:
+{faults}
+  - {{at_s: 8, vehicle: work, param: SIM_LINK_LOSS, value: 0.9}}
+"""
+
+
+def test_a_lossy_link_loses_no_event(tmp_path):
+    """Ten parameter faults (twenty events) and the work UAV's own link made to lose 90 %:
+    over a link losing 30 % each way the summary lists every event the lossless run does (an
+    event leaves in its step's marker datagram, which is asked for again until it arrives)."""
+    faults = "\n".join(
+        f"  - {{at_s: {at}, vehicle: {vehicle}, param: {param}, value: {at % 3 + 2}, "
+        "duration_s: 0.5}"
+        for vehicle, param in (("support-1", "SIM_MP_SCALE"), ("support-2", "SIM_CAM_NOISE"))
+        for at in (2, 3, 4, 5, 6)
+    )
+    scenario = tmp_path / "lossy-faults.yaml"
+    scenario.write_text(LOSSY_FAULTS.format(faults=faults))
+    summaries = []
+    for name, flags in (("clean", []), ("lossy", ["--link-loss", "0.3"])):
+        result = mission("run", str(scenario), "--out", str(tmp_path / name), *flags)
+        assert result.returncode == 0, result.stderr
+        summaries.append(json.loads((tmp_path / name / "summary.json").read_text()))
+    clean, lossy = summaries
+    assert len(clean["events"]) == 21
+    assert clean["events"][-1] == {
+        "t": 8.0,
+        "vehicle": "work",
+        "source": "scenario",
+        "event": "SIM_LINK_LOSS=0.9",
+    }
+    assert lossy["link"]["dropped_out"] > 0
+    assert lossy["events"] == clean["events"]
+    assert lossy["decisions_digest"] == clean["decisions_digest"]
