@@ -34,6 +34,12 @@ def _u16(value: float) -> int:
     return int(min(max(round(value), 0), UINT16_UNKNOWN - 1))
 
 
+def _i16(value: float) -> int:
+    """An int16 field's value, held at its range (327 m/s in cm/s: no flight of ours, but a
+    vehicle the settings made unstable must still say where it is)."""
+    return int(min(max(round(value), -(2**15)), 2**15 - 1))
+
+
 def heartbeat(
     mode: int, armed: bool, failsafe: bool, crashed: bool = False
 ) -> mavlink2.MAVLink_heartbeat_message:
@@ -171,7 +177,7 @@ def global_position_int(
 ) -> mavlink2.MAVLink_global_position_int_message:
     """GLOBAL_POSITION_INT of the believed position."""
     lat_e7, lon_e7, alt_m = frame.to_degE7(position_enu)
-    vn, ve, vd = (round(float(v) * 100) for v in enu_to_ned(velocity_enu))
+    vn, ve, vd = (_i16(float(v) * 100) for v in enu_to_ned(velocity_enu))
     relative_mm = round((float(position_enu[2]) - float(home_enu[2])) * 1000)
     return mavlink2.MAVLink_global_position_int_message(
         time_boot_ms, lat_e7, lon_e7, round(alt_m * 1000), relative_mm, vn, ve, vd, UINT16_UNKNOWN

@@ -22,7 +22,7 @@ FAILURE_TYPES = {
     "gps": ("off", "stuck", "garbage", "wrong", "delayed"),
     "camera": ("off", "stuck", "wrong"),
 }
-_VEHICLE = re.compile(r"^(work|support-([1-9][0-9]*))$")
+_VEHICLE = re.compile(r"work|support-([1-9][0-9]*)")  # fullmatch: "$" passes a final newline
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,7 @@ class Fault:
     def __post_init__(self) -> None:
         require(math.isfinite(self.at_s) and self.at_s >= 0, "at_s", "must be 0 or more")
         require(
-            _VEHICLE.match(self.vehicle) is not None,
+            _VEHICLE.fullmatch(self.vehicle) is not None,
             "vehicle",
             f"must be 'work' or 'support-N', got {self.vehicle!r}",
         )
@@ -81,6 +81,11 @@ class Fault:
         require(refusal is None, "value", f"{spec.name} {refusal}")
 
     @property
+    def on_camera(self) -> bool:
+        """True for a camera failure or a camera parameter (SIM_CAM_*)."""
+        return self.target == "camera" or str(self.param).startswith("SIM_CAM_")
+
+    @property
     def target(self) -> str:
         """What the fault acts on: a failure's unit or a parameter's id (``SIM_GPS1_ENABLE``
         turns the gps unit off and on)."""
@@ -94,22 +99,24 @@ class Fault:
         return math.inf if self.duration_s is None else self.at_s + self.duration_s
 
 
-def check_faults(faults: Sequence[Fault], supports: int, run_end_s: float) -> None:
-    """Each fault against the scenario: its vehicle is flown, a camera failure is on a
-    support (the work UAV has none), it starts before the run ends, and no two faults on the
-    same vehicle and unit or parameter overlap (the earlier's end would undo the later)."""
+def check_faults(faults: Sequence[Fault], supports: int, run_end_s: float, step_s: float) -> None:
+    """Each fault against the scenario: its vehicle is flown, a camera fault is on a support
+    (the work UAV has none), it starts before the run ends and lasts a vehicle step at least
+    (``step_s``: a start and its end at one step boundary would end it before it began), and
+    no two faults on the same vehicle and unit or parameter overlap (the earlier's end would
+    undo the later, an open-ended one's included)."""
     for i, fault in enumerate(faults):
         where = f"faults[{i}]"
-        match = _VEHICLE.match(fault.vehicle)
-        number = int(match.group(2)) if match and match.group(2) else 0
+        match = _VEHICLE.fullmatch(fault.vehicle)
+        number = int(match.group(1)) if match and match.group(1) else 0
         require(
             number <= supports,
             f"{where}.vehicle",
             f"no {fault.vehicle} in this scenario (task.supports = {supports})",
         )
         require(
-            not (fault.vehicle == "work" and fault.target == "camera"),
-            f"{where}.failure",
+            not (fault.vehicle == "work" and fault.on_camera),
+            f"{where}.{'failure' if fault.failure is not None else 'param'}",
             "the work UAV carries no camera",
         )
         require(
@@ -117,14 +124,19 @@ def check_faults(faults: Sequence[Fault], supports: int, run_end_s: float) -> No
             f"{where}.at_s",
             f"{fault.at_s:g} s is past the run's end (run.timeout_s = {run_end_s:g} s)",
         )
+        if fault.duration_s is not None:
+            require(
+                fault.duration_s >= step_s - 1e-9,
+                f"{where}.duration_s",
+                f"{fault.duration_s:g} s is shorter than a vehicle step (control.t_cont_s = "
+                f"{step_s:g} s)",
+            )
     for i, fault in enumerate(faults):
         for j, other in enumerate(faults[:i]):
             if (other.vehicle, other.target) != (fault.vehicle, fault.target):
                 continue
             first, second = (other, fault) if other.at_s <= fault.at_s else (fault, other)
-            overlap = first.at_s == second.at_s or (
-                first.duration_s is not None and second.at_s < first.end_s
-            )
+            overlap = second.at_s < first.end_s  # an open-ended first ends at infinity
             require(
                 not overlap,
                 f"faults[{i}]",

@@ -8,6 +8,7 @@ from typing import Literal
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
+from mission.config.flight_checks import check_flyable
 from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
 
 
@@ -64,3 +65,5 @@ class VehicleSettings:
         _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
         _require(self.mission_retries >= 0, "mission_retries", "must not be negative")
         _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")
+        if self.dynamics == "multicopter":
+            check_flyable(self.multicopter, self.autopilot)

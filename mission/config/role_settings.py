@@ -77,9 +77,32 @@ def check_roles(roles: RoleSettings, supports: int) -> None:
     )
 
 
-def check_inspections(inspections: list[Inspection], supports: int, workspace) -> None:
+def check_waypoints(task, workspace, ground_clearance_m: float) -> None:
+    """The work UAV's waypoints and the supports' inspections (:func:`check_inspections`):
+    every waypoint inside the workspace and at least ``ground_clearance_m`` (the safety
+    clearance, control.clearance_m) above the ground, which no flight could keep below it."""
+    for i, point in enumerate(task.work_waypoints_m):
+        _check_point(point, f"task.work_waypoints_m[{i}]", workspace, ground_clearance_m)
+    check_inspections(task.inspections, task.supports, workspace, ground_clearance_m)
+
+
+def _check_point(point, where: str, workspace, ground_clearance_m: float) -> None:
+    inside = all(workspace.min_m[a] <= point[a] <= workspace.max_m[a] for a in range(3))
+    _require(inside, where, f"{list(point)} lies outside the workspace")
+    _require(
+        point[2] >= ground_clearance_m,
+        where,
+        f"{list(point)} is {point[2]:g} m above the ground, less than control.clearance_m "
+        f"({ground_clearance_m:g} m)",
+    )
+
+
+def check_inspections(
+    inspections: list[Inspection], supports: int, workspace, ground_clearance_m: float
+) -> None:
     """Each entry names a support of the scenario, once, and every waypoint lies inside the
-    workspace (inside the structure is checked with the world, before a run starts)."""
+    workspace and ``ground_clearance_m`` above the ground (inside the structure is checked
+    with the world, before a run starts)."""
     seen: set[str] = set()
     names = {f"support-{n}" for n in range(1, supports + 1)}
     for i, inspection in enumerate(inspections):
@@ -92,7 +115,4 @@ def check_inspections(inspections: list[Inspection], supports: int, workspace) -
         _require(inspection.vehicle not in seen, f"{where}.vehicle", "is listed twice")
         seen.add(inspection.vehicle)
         for j, point in enumerate(inspection.waypoints_m):
-            inside = all(workspace.min_m[a] <= point[a] <= workspace.max_m[a] for a in range(3))
-            _require(
-                inside, f"{where}.waypoints_m[{j}]", f"{list(point)} lies outside the workspace"
-            )
+            _check_point(point, f"{where}.waypoints_m[{j}]", workspace, ground_clearance_m)

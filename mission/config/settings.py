@@ -22,8 +22,8 @@ from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSett
 from mission.config.role_settings import (
     Inspection,
     RoleSettings,
-    check_inspections,
     check_roles,
+    check_waypoints,
 )
 from mission.config.wind_settings import WindSettings
 
@@ -361,12 +361,8 @@ class Scenario:
     def __post_init__(self) -> None:
         self._check_margins()
         self._check_integrity()
-        check_faults(self.faults, self.task.supports, self.run.timeout_s)
-        for i, point in enumerate(self.task.work_waypoints_m):
-            box = self.world.workspace
-            inside = all(box.min_m[a] <= point[a] <= box.max_m[a] for a in range(3))
-            _require(inside, f"task.work_waypoints_m[{i}]", f"{point} lies outside the workspace")
-        check_inspections(self.task.inspections, self.task.supports, self.world.workspace)
+        check_faults(self.faults, self.task.supports, self.run.timeout_s, self.control.t_cont_s)
+        check_waypoints(self.task, self.world.workspace, self.control.clearance_m)
         check_roles(self.roles, self.task.supports)
 
     def _check_integrity(self) -> None:

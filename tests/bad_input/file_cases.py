@@ -37,6 +37,13 @@ OVERLAP = (
     "  - {at_s: 10, vehicle: support-2, failure: gps off, duration_s: 30}\n"
     "  - {at_s: 20, vehicle: support-2, param: SIM_GPS1_ENABLE, value: 0}\n"
 )
+OPEN_ENDED_OVERLAP = (  # the later one's end would undo the open-ended "off"
+    "faults:\n"
+    "  - {at_s: 10, vehicle: support-1, failure: gps off}\n"
+    "  - {at_s: 20, vehicle: support-1, failure: gps wrong, duration_s: 5}\n"
+)
+
+FLOWN = "vehicle: {dynamics: multicopter, %s}\n"
 
 INSPECTIONS = "task:\n  inspections:\n    - {vehicle: %s, waypoints_m: [%s]}\n"
 
@@ -115,6 +122,52 @@ FILE_CASES = [
         lambda t: [*RUN, str(scenario_file(t, "integrity: {motion_sigma_m: .inf}\n"))],
         ["bad.yaml", "integrity.motion_sigma_m", "finite"],
     ),
+    # --- a body, loop or wind the model cannot fly or integrate (issue 46) ---------------
+    *[
+        (
+            f"yaml-flight-{case}",
+            lambda t, text=text: [*RUN, str(scenario_file(t, text))],
+            ["bad.yaml", field, problem],
+        )
+        for case, text, field, problem in (
+            ("mass", FLOWN % "multicopter: {mass_kg: 1.0e-9}", "multicopter.mass_kg", "mass over"),
+            (
+                "inertia",
+                FLOWN % "multicopter: {inertia_kg_m2: [1.0e-9, 1.0e-9, 1.0e-9]}",
+                "multicopter.inertia_kg_m2",
+                "cannot integrate",
+            ),
+            (
+                "motor-lag",
+                FLOWN % "multicopter: {motor_tau_s: 1.0e-9}",
+                "multicopter.motor_tau_s",
+                "cannot integrate",
+            ),
+            (
+                "drag",
+                FLOWN % "multicopter: {drag_n_per_m_s: 1.0e+9}",
+                "multicopter.mass_kg",
+                "mass over drag",
+            ),
+            ("rate-1e6", FLOWN % "multicopter: {rate_hz: 1.0e+6}", "rate_hz", "at most 2000"),
+            ("rate-1e300", FLOWN % "multicopter: {rate_hz: 1.0e+300}", "rate_hz", "at most"),
+            (
+                "rate-gain",
+                FLOWN % "autopilot: {rate_gain_per_s: 1.0e+6}",
+                "autopilot.rate_gain_per_s",
+                "rate loop",
+            ),
+            (
+                "cascade",
+                FLOWN % "autopilot: {position_gain_per_s: 3.0}",
+                "autopilot.position_gain_per_s",
+                "below velocity_gain_per_s",
+            ),
+            ("wind-45", "world: {wind: {speed_m_s: 45}}\n", "wind.speed_m_s", "[0, 40]"),
+            ("wind-1e6", "world: {wind: {speed_m_s: 1.0e+6}}\n", "wind.speed_m_s", "[0, 40]"),
+            ("turbulence", "world: {wind: {turbulence: 1.0e+6}}\n", "wind.turbulence", "[0, 10]"),
+        )
+    ],
     # --- safety margins ----------------------------------------------------------------
     (
         "yaml-negative-margin",
@@ -184,6 +237,35 @@ FILE_CASES = [
         "faults-overlap",
         lambda t: [*RUN, str(scenario_file(t, OVERLAP))],
         ["bad.yaml", "faults[1]", "overlaps faults[0] on support-2's gps"],
+    ),
+    (
+        "faults-overlap-open-ended",
+        lambda t: [*RUN, str(scenario_file(t, OPEN_ENDED_OVERLAP))],
+        ["bad.yaml", "faults[1]", "overlaps faults[0] on support-1's gps"],
+    ),
+    _fault_case(
+        "faults-vehicle-with-a-newline",
+        'vehicle: "support-1\\n", failure: gps off',
+        "vehicle",
+        "must be 'work' or 'support-N'",
+    ),
+    _fault_case(
+        "faults-parameter-shorter-than-a-step",
+        "vehicle: support-1, param: SIM_MP_SCALE, value: 2, duration_s: 1.0e-20",
+        "duration_s",
+        "shorter than a vehicle step",
+    ),
+    _fault_case(
+        "faults-failure-shorter-than-a-step",
+        "vehicle: support-1, failure: gps off, duration_s: 0.1",
+        "duration_s",
+        "shorter than a vehicle step",
+    ),
+    _fault_case(
+        "faults-camera-parameter-on-the-work-uav",
+        "vehicle: work, param: SIM_CAM_RANGE, value: 5",
+        "param",
+        "the work UAV carries no camera",
     ),
     # --- scenario YAML -----------------------------------------------------------------
     (

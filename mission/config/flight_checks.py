@@ -1,0 +1,76 @@
+"""Whether a multicopter's settings can be flown and integrated (issue 46): checked up front,
+so that a body or loop the model cannot integrate is refused on one line, not found out by
+every vehicle dying at its first step.
+
+- The integration step h = 1 / ``rate_hz`` (at most :data:`MAX_RATE_HZ`: a step of substeps
+  is computed whole) is at most half of the body's fastest time constants: the motors' lag,
+  mass over drag, the least moment of inertia over the rotational damping (a classical
+  Runge-Kutta step is stable to |lambda h| ~ 2.8; two steps a time constant keeps it accurate).
+- The rate loop, a gain K on the rate error through the motors' first-order lag tau, is the
+  second-order loop s^2 tau + s + K: its natural frequency sqrt(K / tau) at most
+  :data:`MAX_LOOP_FREQUENCY_STEPS` / h (it runs once a substep, its command held) and its
+  damping 1 / (2 sqrt(K tau)) at least :data:`MIN_RATE_LOOP_DAMPING`.
+- The cascade runs each loop slower than the one inside it: position, velocity, attitude, rate.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+from mission.config.checks import require
+from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
+
+MAX_RATE_HZ = 2000.0
+STEPS_PER_TIME_CONSTANT = 2.0
+MAX_LOOP_FREQUENCY_STEPS = 0.5  # the rate loop's natural frequency times h
+MIN_RATE_LOOP_DAMPING = 0.2
+
+
+def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
+    """FieldProblem naming ``multicopter.*`` or ``autopilot.*`` where they cannot be flown."""
+    require(
+        body.rate_hz <= MAX_RATE_HZ,
+        "multicopter.rate_hz",
+        f"must be at most {MAX_RATE_HZ:g} Hz, got {body.rate_hz:g}",
+    )
+    h = 1.0 / body.rate_hz
+    constants = [("motor_tau_s", "the motors' lag", body.motor_tau_s)]
+    if body.drag_n_per_m_s > 0:
+        constants.append(("mass_kg", "mass over drag", body.mass_kg / body.drag_n_per_m_s))
+    if body.rotational_damping_n_m_per_rad_s > 0:
+        least = min(body.inertia_kg_m2) / body.rotational_damping_n_m_per_rad_s
+        constants.append(("inertia_kg_m2", "inertia over rotational damping", least))
+    for name, what, tau in constants:
+        require(
+            tau >= STEPS_PER_TIME_CONSTANT * h,
+            f"multicopter.{name}",
+            f"makes {what} {tau:.3g} s, shorter than {STEPS_PER_TIME_CONSTANT:g} integration "
+            f"steps ({STEPS_PER_TIME_CONSTANT * h:.3g} s at rate_hz {body.rate_hz:g}): the "
+            "model cannot integrate it",
+        )
+    gain, lag = loops.rate_gain_per_s, body.motor_tau_s
+    frequency, damping = math.sqrt(gain / lag), 1.0 / (2.0 * math.sqrt(gain * lag))
+    require(
+        frequency * h <= MAX_LOOP_FREQUENCY_STEPS,
+        "autopilot.rate_gain_per_s",
+        f"{gain:g} makes the rate loop ring at {frequency:.3g} rad/s, too fast for its "
+        f"{body.rate_hz:g} Hz (at most {MAX_LOOP_FREQUENCY_STEPS * body.rate_hz:.3g})",
+    )
+    require(
+        damping >= MIN_RATE_LOOP_DAMPING,
+        "autopilot.rate_gain_per_s",
+        f"{gain:g} with the motors' {lag:g} s lag damps the rate loop {damping:.2f} "
+        f"(at least {MIN_RATE_LOOP_DAMPING:g}: K tau at most "
+        f"{1 / (4 * MIN_RATE_LOOP_DAMPING**2):g})",
+    )
+    cascade = ("position", "velocity", "attitude", "rate")
+    for outer, inner in itertools.pairwise(cascade):
+        slow = getattr(loops, f"{outer}_gain_per_s")
+        fast = getattr(loops, f"{inner}_gain_per_s")
+        require(
+            slow < fast,
+            f"autopilot.{outer}_gain_per_s",
+            f"{slow:g} must be below {inner}_gain_per_s ({fast:g}): a loop slower than the "
+            "one it commands",
+        )
