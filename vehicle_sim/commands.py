@@ -34,6 +34,8 @@ DENIED = mavlink2.MAV_RESULT_DENIED
 UNSUPPORTED = mavlink2.MAV_RESULT_UNSUPPORTED
 FAILED = mavlink2.MAV_RESULT_FAILED
 REQUESTABLE_ONCE = (mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION,)
+MAX_INTERVAL_ID = 0xFFFF  # MESSAGE_INTERVAL.message_id is a uint16
+MAX_INTERVAL_US = 2**31 - 1  # and its interval_us an int32
 
 
 def execute(vehicle: Vehicle, command: int, params: list[float]) -> int:
@@ -72,16 +74,24 @@ def _do_set_mode(vehicle: Vehicle, params: list[float]) -> int:
     return set_mode(vehicle, int(params[0]), int(params[1]))
 
 
+def _interval_id(value: float) -> int | None:
+    """A message id MESSAGE_INTERVAL can carry, or None."""
+    if math.isnan(value) or value != int(value) or not 0 <= value <= MAX_INTERVAL_ID:
+        return None
+    return int(value)
+
+
 def _set_interval(vehicle: Vehicle, params: list[float]) -> int:
-    if math.isnan(params[0]) or math.isnan(params[1]):
-        return DENIED
-    return ACCEPTED if vehicle.set_interval(int(params[0]), params[1]) else UNSUPPORTED
+    message_id = _interval_id(params[0])
+    if message_id is None or math.isnan(params[1]) or params[1] > MAX_INTERVAL_US:
+        return DENIED  # an interval MESSAGE_INTERVAL could not report back
+    return ACCEPTED if vehicle.set_interval(message_id, params[1]) else UNSUPPORTED
 
 
 def _get_interval(vehicle: Vehicle, params: list[float]) -> int:
-    if math.isnan(params[0]):
+    message_id = _interval_id(params[0])
+    if message_id is None:
         return DENIED
-    message_id = int(params[0])
     if message_id not in vehicle.intervals_s:
         vehicle.send(mavlink2.MAVLink_message_interval_message(message_id, 0))
         return ACCEPTED

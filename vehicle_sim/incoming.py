@@ -8,6 +8,7 @@ on bad content (it is counted and, where a pilot would want to know, said once).
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Callable
 from typing import Any
 
@@ -108,7 +109,10 @@ def on_command(vehicle: Any, msg: Any) -> None:
         params += [msg.param5, msg.param6, msg.param7]
     else:
         params += [msg.x, msg.y, msg.z]
-    result = execute(vehicle, int(msg.command), params)
+    try:
+        result = execute(vehicle, int(msg.command), params)
+    except (struct.error, OverflowError, ValueError):  # a value no reply could carry
+        result = mavlink2.MAV_RESULT_FAILED  # answered all the same, as ArduPilot does
     vehicle.send(
         mavlink2.MAVLink_command_ack_message(
             msg.command, result, 0, 0, msg.get_srcSystem(), msg.get_srcComponent()

@@ -250,9 +250,20 @@ def test_commands_are_acknowledged(frame):
         client.collect(0.3)
         assert not [m for m in client.collect(1.5) if m.get_type() == "GPS_RAW_INT"]
         assert (
-            client.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, 99999, 1e6, system_id=3)
+            client.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, 9999, 1e6, system_id=3)
             == mavlink2.MAV_RESULT_UNSUPPORTED
         )
+        # ids and intervals MESSAGE_INTERVAL cannot carry (uint16, int32) are refused, answered
+        denied = mavlink2.MAV_RESULT_DENIED
+        for command, params in (
+            (mavlink2.MAV_CMD_GET_MESSAGE_INTERVAL, (70000,)),
+            (mavlink2.MAV_CMD_GET_MESSAGE_INTERVAL, (-1,)),
+            (mavlink2.MAV_CMD_GET_MESSAGE_INTERVAL, (1e30,)),
+            (mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, (99999, 1e6)),
+            (mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, (24, 1e30)),
+        ):
+            assert client.command(command, *params, system_id=3) == denied, (command, params)
+        assert client.command(mavlink2.MAV_CMD_GET_MESSAGE_INTERVAL, 24, system_id=3) == ok
         assert (
             client.command(mavlink2.MAV_CMD_DO_SET_MODE, 1, 77, system_id=3)
             == mavlink2.MAV_RESULT_DENIED
