@@ -6,9 +6,7 @@ ground station's ``records.jsonl``.
 
 from __future__ import annotations
 
-import json
 from collections import Counter
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -17,17 +15,6 @@ from mission.analysis.metrics import RunTrace, work_errors, zone_steps
 from mission.config.settings import Scenario
 from mission.link.plan_files import read_vehicle_waypoints
 from mission.world.model import World
-
-
-def read_records(path: Path) -> list[dict[str, Any]]:
-    """The ground station's per-cycle records (an unfinished last line is left out)."""
-    records = []
-    for line in path.read_text(encoding="utf-8").splitlines():
-        try:
-            records.append(json.loads(line))
-        except ValueError:
-            continue
-    return records
 
 
 def diagnostics(

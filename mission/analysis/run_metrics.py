@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from mission.analysis.decisions import decisions_digest
-from mission.analysis.diagnostics import diagnostics, read_records
+from mission.analysis.diagnostics import diagnostics
 from mission.analysis.integrity import integrity_metrics
 from mission.analysis.metrics import (
     RunTrace,
@@ -17,6 +17,7 @@ from mission.analysis.metrics import (
     read_tlog,
     trace_metrics,
 )
+from mission.analysis.records_file import read_records
 from mission.analysis.roles import role_metrics
 from mission.config.settings import Scenario
 from mission.world.model import World

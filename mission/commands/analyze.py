@@ -1,5 +1,6 @@
 """``mission analyze``: a finished run's metrics recomputed from its tlog, and its figures; a
-summary is never made worse by a cut tlog."""
+summary is never made worse by a cut tlog or damaged records (cut, emptied, doubled, or with a
+line that is not a cycle's record)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import json
 import sys
 from pathlib import Path
 
+from mission.analysis.records_file import RecordsFile, read_records_file
 from mission.commands.common import add_run_scenario_option
 from mission.commands.run_files import previous_summary, run_scenario
 from mission.config.errors import InputError
@@ -44,11 +46,14 @@ def analyze(args: argparse.Namespace) -> int:
     plots = tlog.parent / "plots"
     if args.plots:
         _check_plots(plots)
+    records = _records_beside(tlog)  # a damaged file refused before the tlog is read
     trace, world = read_tlog(tlog, scenario), World(scenario)
     metrics = metrics_of(trace, world, tlog.parent, scenario)
     if not metrics["control_cycles"]:
         raise InputError(str(tlog), "", "holds no control cycle of a ground station")
     _check_holds_the_summary(tlog, metrics, previous)
+    if records is not None:
+        _check_records_hold_the_cycles(tlog.parent / "records.jsonl", records, metrics)
     merged = {**previous, **metrics}
     if previous:
         from mission.procs.atomic import write_text_atomically
@@ -72,6 +77,25 @@ def _check_plots(plots: Path) -> None:
     for name in FIGURES:
         if (plots / name).is_dir():
             raise InputError("command line", "--plots", f"{plots / name} is a directory")
+
+
+def _records_beside(tlog: Path) -> RecordsFile | None:
+    """The run's records.jsonl, checked line by line (None: the tlog has none beside it)."""
+    path = tlog.parent / "records.jsonl"
+    return read_records_file(path) if path.is_file() else None
+
+
+def _check_records_hold_the_cycles(path: Path, records: RecordsFile, metrics: dict) -> None:
+    """Records of fewer cycles than the tlog's (one fewer where the station stopped between
+    a cycle's commands and its record) were cut short or emptied: the summary is kept."""
+    cycles, held = metrics["control_cycles"], len(records.records)
+    if held < cycles - 1:
+        raise InputError(
+            str(path),
+            "",
+            f"holds {held} control cycles' records where the tlog has {cycles}: cut short? "
+            "summary.json is not rewritten",
+        )
 
 
 def _check_holds_the_summary(tlog: Path, metrics: dict, previous: dict) -> None:

@@ -5,12 +5,12 @@ what is not whole yet; a finished run has no such excuse."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from mission.analysis.metrics import scan_records
+from mission.analysis.records_file import read_records_file
 from mission.config.errors import InputError
 from mission.viewer.tail import SNAPSHOT_NAME, VIEWED_IDS
 
@@ -46,20 +46,10 @@ def _check_tlog(path: Path) -> list[str]:
 
 def _check_records(path: Path) -> tuple[int, bool]:
     """(whole cycle records, whether the last line is cut)."""
-    data = path.read_bytes()
-    lines = data.split(b"\n")
-    cut = bool(lines[-1])  # no newline after the last line
-    whole = lines[:-1]
-    for number, line in enumerate(whole, start=1):
-        try:
-            record = json.loads(line)
-        except ValueError:
-            record = None
-        if not isinstance(record, dict) or not isinstance(record.get("t"), int | float):
-            raise InputError(str(path), f"line {number}", "is not a control cycle's record")
-    if not whole:
+    found = read_records_file(path)
+    if not found.records:
         raise InputError(str(path), "", "holds no control cycle's record")
-    return len(whole), cut
+    return len(found.records), found.cut
 
 
 def _check_snapshots(g_dir: Path, shape: tuple[int, ...]) -> None:

@@ -7,7 +7,6 @@ this imports Rerun.
 
 from __future__ import annotations
 
-import json
 import os
 import re
 from pathlib import Path
@@ -19,6 +18,7 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.analysis.metrics import scan_records
+from mission.analysis.record_schema import parse_record
 from mission.procs.file_tail import FileTail
 
 VIEWED_IDS = frozenset(
@@ -76,11 +76,8 @@ class RecordsTail:
     def read(self) -> list[dict[str, Any]]:
         records = []
         for line in self._file.new_lines():
-            try:
-                record = json.loads(line)
-            except ValueError:
-                continue
-            if isinstance(record, dict) and "t" in record:
+            record, _ = parse_record(line)  # a line that is not a record is not shown
+            if record is not None:
                 records.append(record)
         return records
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mission.analysis.decisions import decisions_digest
-from mission.analysis.diagnostics import read_records
+from mission.analysis.records_file import read_records
 from tests.processes import mission
 from tests.shared_runs import SHORT
 

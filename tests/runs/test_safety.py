@@ -14,7 +14,7 @@ import pytest
 import trimesh
 
 from mission.analysis.decisions import decisions_digest
-from mission.analysis.diagnostics import read_records
+from mission.analysis.records_file import read_records
 from mission.config.scenario import load_scenario
 from mission.world.model import World
 from tests.margins_check import independent_truth, run_margins

@@ -3,7 +3,6 @@ cut short: each case on files built here (a tlog of real MAVLink 2 records)."""
 
 from __future__ import annotations
 
-import json
 import os
 import struct
 from pathlib import Path
@@ -16,6 +15,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.config.errors import InputError
 from mission.viewer.check import check_run_files
+from tests.cycle_records import cycle_lines
 
 SHAPE = (4, 3, 2)
 
@@ -39,7 +39,7 @@ def _run(tmp_path: Path, tlog: bytes, records: bytes) -> Path:
     return run
 
 
-CYCLES = b"".join(json.dumps({"t": 0.5 * k}).encode() + b"\n" for k in range(1, 5))
+CYCLES = cycle_lines([0.5 * k for k in range(1, 5)])
 
 
 def test_a_whole_run_passes_without_a_word(tmp_path):
@@ -50,8 +50,8 @@ def test_a_whole_run_passes_without_a_word(tmp_path):
     ("tlog", "records", "snapshot", "expected"),
     [
         (os.urandom(5000), CYCLES, None, "gcs.tlog: holds no vehicle message"),
-        (_tlog(8), os.urandom(300).replace(b"\n", b" ") + b"\n", None, "line 1: is not a control"),
-        (_tlog(8), CYCLES + b"[1, 2]\n", None, "line 5: is not a control cycle's record"),
+        (_tlog(8), os.urandom(300).replace(b"\n", b" ") + b"\n", None, "line 1: not a control"),
+        (_tlog(8), CYCLES + b"[1, 2]\n", None, "line 5: not a control cycle's record"),
         (_tlog(8), b"", None, "records.jsonl: holds no control cycle's record"),
         (_tlog(8), CYCLES, os.urandom(4000), "G_20.npy: not a G snapshot"),
         (_tlog(8), CYCLES, np.ones(7), "G_20.npy: not a G snapshot of this map"),
