@@ -62,12 +62,13 @@ def read_results_csv(text: str) -> list[dict]:
     """The rows of a results.csv, each value as the summary held it: empty as None, True and
     False as booleans, whole numbers as ints, other numbers as floats, the rest as text."""
     return [
-        {key: _value(cell) for key, cell in row.items()}
+        {key: read_cell(cell) for key, cell in row.items()}
         for row in csv.DictReader(io.StringIO(text))
     ]
 
 
-def _value(cell: str) -> Any:
+def read_cell(cell: str) -> Any:
+    """A cell's value as the summary held it (:func:`read_results_csv`)."""
     if cell == "":
         return None
     if cell in ("True", "False"):

@@ -27,7 +27,8 @@ from mission.studies.provenance_file import (
     write_provenance,
 )
 from mission.studies.report import write_report
-from mission.studies.results import read_results_csv, result_row, results_csv
+from mission.studies.results import result_row, results_csv
+from mission.studies.results_check import checked_results
 from mission.studies.runkeys import StudyRun, code_version, study_runs
 from mission.studies.spec import StudySpec, validate_points
 from mission.studies.table3 import write_tables
@@ -178,8 +179,9 @@ class StudyOutputs:
 def rewrite_report(spec: StudySpec, out_dir: Path) -> int:
     """report.md, its figures (and Table 3 if the study asks) written again from
     ``out_dir``'s results.csv and provenance.json, running nothing: a report of the code of the
-    day from rows of an earlier run of the study. The number of rows."""
-    rows = read_results_csv((out_dir / "results.csv").read_text(encoding="utf-8"))
+    day from rows of an earlier run of the study. The number of rows. A results.csv that does
+    not hold this study's rows is refused (InputError) before anything is written."""
+    rows = checked_results(out_dir / "results.csv", plan_runs(spec))  # before any writing
     write_report(out_dir, spec, rows, failed=0, provenance=read_provenance(out_dir))
     if "table3" in spec.tables:
         write_tables(out_dir, rows)
