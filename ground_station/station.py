@@ -115,7 +115,7 @@ class GroundStation:
         self.tlog.flush()
         self.records.link_stats(self.links.report(self.config.link))
         return {
-            "completed": completion is not None,
+            "completed": completion is not None and self.stopped is None,  # a crash fails it
             "completion_time_s": completion,
             "stopped": self.stopped,
             "control_cycles": self.cycles,

@@ -70,3 +70,15 @@ def test_the_bench_names_each_group_as_it_goes(monkeypatch):
     lines = progress.getvalue().splitlines()
     assert lines[0] == "bench: quick ..." and lines[1].startswith("bench: quick done in ")
     assert len(lines) == 2  # the group not asked for is not run
+
+
+def test_a_run_whose_inspections_were_not_done_says_so_beside_the_work_uav_s_completion():
+    reached = {
+        "work": {"reached": 14, "of": 14},
+        "support-1": {"reached": 3, "of": 3},
+        "support-2": {"reached": 1, "of": 4},
+    }
+    line = run_line({**SUMMARY, "roles": {"waypoints_reached": reached}}, 900.0)
+    assert line.startswith(
+        "completed at 254.5 s, inspections NOT done within 900 s (support-2); 509 cycles;"
+    )

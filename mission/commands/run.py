@@ -181,6 +181,10 @@ def run_line(summary: dict, timeout_s: float) -> str:
     """A finished run in one line of text."""
     if summary["completed"]:
         done = f"completed at {summary['completion_time_s']:.1f} s"
+        reached = ((summary.get("roles") or {}).get("waypoints_reached")) or {}
+        behind = [n for n, w in reached.items() if n != "work" and w["reached"] < w["of"]]
+        if behind:  # the work UAV's task done, a support's inspections not
+            done += f", inspections NOT done within {timeout_s:g} s ({', '.join(behind)})"
     elif summary.get("stopped"):
         done = f"STOPPED: {summary['stopped']}"
     else:

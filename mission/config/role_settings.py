@@ -68,12 +68,21 @@ class Inspection:
         _require(bool(self.waypoints_m), "waypoints_m", "needs at least one waypoint")
 
 
-def check_roles(roles: RoleSettings, supports: int) -> None:
-    """The formation kept while supports inspect has no more supports than the scenario."""
+def check_roles(roles: RoleSettings, supports: int, arrival_tol_m: float) -> None:
+    """The formation kept while supports inspect has no more supports than the scenario; an
+    inspection waypoint's tolerance is no tighter than the work UAV's arrival's
+    (control.arrival_tol_m), or a support's noisy fix would seldom if ever come that close."""
     _require(
         roles.keep_in_formation <= supports,
         "roles.keep_in_formation",
         f"{roles.keep_in_formation} is more than the scenario's {supports} supports",
+    )
+    tolerance = roles.inspection_tol_m
+    _require(
+        tolerance >= arrival_tol_m,
+        "roles.inspection_tol_m",
+        f"{tolerance:g} m is less than control.arrival_tol_m ({arrival_tol_m:g} m): a "
+        "support's noisy fix would seldom if ever come that close",
     )
 
 

@@ -363,7 +363,7 @@ class Scenario:
         self._check_integrity()
         check_faults(self.faults, self.task.supports, self.run.timeout_s, self.control.t_cont_s)
         check_waypoints(self.task, self.world.workspace, self.control.clearance_m)
-        check_roles(self.roles, self.task.supports)
+        check_roles(self.roles, self.task.supports, self.control.arrival_tol_m)
 
     def _check_integrity(self) -> None:
         """The monitor's sustain and recovery fit in the run."""

@@ -74,6 +74,28 @@ FILE_CASES = [
         ["bad.yaml", "task.inspections[0].waypoints_m[0]", "outside the workspace"],
     ),
     (
+        "yaml-inspection-on-the-ground",
+        lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-2", "[0.0, -16.0, 0.1]")))],
+        ["bad.yaml", "task.inspections[0].waypoints_m[0]", "less than control.clearance_m"],
+    ),
+    (
+        "yaml-work-waypoint-on-the-ground",
+        lambda t: [
+            *RUN,
+            str(
+                scenario_file(
+                    t, "task: {work_waypoints_m: [[-6.0, -3.0, 0.2], [-3.0, -3.0, 7.0]]}\n"
+                )
+            ),
+        ],
+        ["bad.yaml", "task.work_waypoints_m[0]", "0.2 m above the ground"],
+    ),
+    (
+        "yaml-inspection-tolerance-tiny",
+        lambda t: [*RUN, str(scenario_file(t, "roles: {inspection_tol_m: 1.0e-9}\n"))],
+        ["bad.yaml", "roles.inspection_tol_m", "less than control.arrival_tol_m"],
+    ),
+    (
         "yaml-inspection-of-no-such-support",
         lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-7", "[0.0, -12.0, 7.0]")))],
         ["bad.yaml", "task.inspections[0].vehicle", "not a support of this scenario"],
