@@ -4,6 +4,7 @@ every study gets before it starts."""
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from mission.commands.study_checks import check_study_outputs, checked_engine
@@ -71,7 +72,7 @@ def study(args: argparse.Namespace) -> int:
     """``mission study``."""
     from mission.studies.spec import load_study
 
-    spec = load_study(args.file)
+    spec = load_study(args.file, say=lambda text: print(text, file=sys.stderr, flush=True))
     if args.historical is not None and not args.report_only:
         raise InputError("command line", "--historical", "is for --report-only")
     if args.verify is not None:

@@ -49,27 +49,44 @@ def resolve_scenario_path(name_or_path: str) -> Path:
     raise ScenarioError(name_or_path, "", f"no such scenario (embedded ones: {names})")
 
 
-def load_scenario(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scenario:
+def load_scenario(
+    name_or_path: str,
+    overrides: dict[str, Any] | None = None,
+    layers: dict[str, Any] | None = None,
+) -> Scenario:
     """Load, merge and validate a scenario given by embedded name or file path; ``overrides``
-    (dotted keys, see :func:`resolved_mapping`) are layered on top."""
+    (dotted keys, see :func:`resolved_mapping`) are layered on top (``layers``: the scenario's
+    :func:`scenario_layers`, read already)."""
     path = resolve_scenario_path(name_or_path)
-    merged = resolved_mapping(name_or_path, overrides)
+    merged = resolved_mapping(name_or_path, overrides, layers)
     merged["source"] = str(path)
     return scenario_from_mapping(merged, path)
 
 
-def resolved_mapping(name_or_path: str, overrides: dict[str, Any] | None = None) -> dict[str, Any]:
+def scenario_layers(name_or_path: str) -> dict[str, Any]:
+    """A scenario's files merged (``extends`` down to the defaults), not yet validated: read
+    once for the many points of a study."""
+    merged = _load_layers(resolve_scenario_path(name_or_path), depth=0)
+    merged.pop("extends", None)
+    return merged
+
+
+def resolved_mapping(
+    name_or_path: str,
+    overrides: dict[str, Any] | None = None,
+    layers: dict[str, Any] | None = None,
+) -> dict[str, Any]:
     """Every setting of a scenario, its layers merged, file references absolute; with
     ``overrides`` ({"fusion.rho_threshold": 0.5, ...}) merged last, as if written at the end of
-    the scenario's own file (a relative path in one is relative to that file)."""
+    the scenario's own file (a relative path in one is relative to that file). ``layers``: the
+    scenario's :func:`scenario_layers`, where they were read already (not changed here)."""
     path = resolve_scenario_path(name_or_path)
-    merged = _load_layers(path, depth=0)
-    merged.pop("extends", None)
+    merged = scenario_layers(name_or_path) if layers is None else layers
     if overrides:
         layer = nest_dotted(overrides)
         _absolutise_paths(layer, path.parent)
-        merged = merge_settings(merged, layer)
-    return merged
+        return merge_settings(merged, layer)  # a copy
+    return merged if layers is None else copy.deepcopy(layers)
 
 
 def nest_dotted(overrides: dict[str, Any]) -> dict[str, Any]:

@@ -9,6 +9,7 @@ e.g. ``world.zones[0].min_m``.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import types
 import typing
@@ -24,8 +25,7 @@ def build_settings(cls: type[T], data: Any, path: str = "") -> T:
     """Return an instance of dataclass ``cls`` built from mapping ``data``."""
     if not isinstance(data, Mapping):
         raise FieldProblem(path or "<root>", f"expected a mapping, got {_kind(data)}")
-    hints = typing.get_type_hints(cls)
-    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    hints, fields = _shape(cls)
     unknown = sorted(set(map(str, data)) - set(fields))
     if unknown:
         where = _join(path, unknown[0])
@@ -45,6 +45,13 @@ def build_settings(cls: type[T], data: Any, path: str = "") -> T:
         return cls(**values)
     except FieldProblem as problem:
         raise FieldProblem(_join(path, problem.field), problem.problem) from None
+
+
+@functools.cache  # a class's annotations do not change: each is read once a process
+def _shape(cls: type) -> tuple[dict[str, Any], dict[str, dataclasses.Field]]:
+    """The type hints and the init fields of dataclass ``cls``."""
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    return typing.get_type_hints(cls), fields
 
 
 def _convert(annotation: Any, value: Any, where: str) -> Any:

@@ -11,7 +11,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from mission.config.scenario import resolved_mapping
+from mission.config.scenario import resolved_mapping, scenario_layers
 from mission.link.plan_files import vehicle_names
 from mission.studies.spec import Point, StudySpec
 
@@ -69,9 +69,11 @@ def study_runs(spec: StudySpec, names: dict[str, str], code: str) -> list[StudyR
     """Every run of the study in order (scenario, point, seed, method: pairs side by side);
     ``names`` gives each scenario reference's own name."""
     runs = []
+    digests: dict[Path, str] = {}  # each named file read once for every point
     for scenario in spec.scenarios:
+        layers = scenario_layers(scenario)
         for number, point in enumerate(spec.points):
-            resolved = resolved_key(scenario, point)
+            resolved = resolved_key(scenario, point, layers, digests)
             for seed in spec.seeds:
                 for method in spec.methods:
                     where = (scenario, names[scenario], number, point)
@@ -97,39 +99,48 @@ def keyed_run(
     return StudyRun(scenario, name, number, point.as_dict(), method, seed, key, speedup)
 
 
-def resolved_key(scenario: str, point: Point) -> str:
+def resolved_key(
+    scenario: str,
+    point: Point,
+    layers: dict[str, Any] | None = None,
+    digests: dict[Path, str] | None = None,
+) -> str:
     """A digest of the resolved scenario: its settings with the contents (not the paths) of
-    the files they name."""
-    mapping = resolved_mapping(scenario, point.as_dict())
-    files = _named_files(mapping)
+    the files they name (``layers``: the scenario's files read already; ``digests``: the
+    files' digests found so far, added to)."""
+    mapping = resolved_mapping(scenario, point.as_dict(), layers)
+    files = _named_files(mapping, {} if digests is None else digests)
     for key in ("mesh_file", "waypoints_dir", "table"):
         _drop_path(mapping, key)
     return _digest({"settings": mapping, "files": files})
 
 
-def _named_files(mapping: dict[str, Any]) -> dict[str, str]:
-    """Digest of each file the settings name: the mesh, the sky table, the waypoint files."""
+def _named_files(mapping: dict[str, Any], digests: dict[Path, str]) -> dict[str, str]:
+    """Digest of each file the settings name: the mesh, the sky table, the waypoint files
+    (each read once: ``digests`` keeps them)."""
     files = {}
     mesh = mapping.get("world", {}).get("structure", {}).get("mesh_file")
     if mesh:
-        files["mesh"] = _file_digest(Path(mesh))
+        files["mesh"] = _file_digest(Path(mesh), digests)
     table = mapping.get("sky", {}).get("table")
     if table and table != "builtin":
-        files["sky"] = _file_digest(Path(table))
+        files["sky"] = _file_digest(Path(table), digests)
     task = mapping.get("task", {})
     folder = Path(task.get("waypoints_dir", "."))
     supports = task.get("supports", 0)
     if isinstance(supports, int) and supports > 0:
         for name in vehicle_names(supports):
-            files[name] = _file_digest(folder / f"{name}.waypoints")
+            files[name] = _file_digest(folder / f"{name}.waypoints", digests)
     return files
 
 
-def _file_digest(path: Path) -> str:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return "missing"
+def _file_digest(path: Path, digests: dict[Path, str]) -> str:
+    if path not in digests:
+        try:
+            digests[path] = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError:
+            digests[path] = "missing"
+    return digests[path]
 
 
 def _drop_path(mapping: dict[str, Any], key: str) -> None:

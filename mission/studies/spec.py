@@ -25,12 +25,18 @@ from __future__ import annotations
 import itertools
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from mission.config.errors import InputError, ScenarioError
-from mission.config.scenario import load_scenario, read_yaml_mapping, resolve_scenario_path
+from mission.config.scenario import (
+    load_scenario,
+    read_yaml_mapping,
+    resolve_scenario_path,
+    scenario_layers,
+)
 from mission.config.settings import Scenario
 from mission.procs.cli_common import MAX_SPEEDUP, MIN_SPEEDUP
 
@@ -48,6 +54,10 @@ _KEYS = {
     "realtime",
 }
 MAX_RUNS = 1_000_000
+# A point's scenario is resolved and checked in a few milliseconds: this many take well under
+# a minute, and a study of more than ANNOUNCED_POINTS says so before it checks them.
+MAX_POINTS = 10_000
+ANNOUNCED_POINTS = 200
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,8 +161,9 @@ def _speedup(source: str, value: Any) -> float | None:
     return float(value)
 
 
-def load_study(path: Path) -> StudySpec:
-    """Read and validate a study file (every scenario at every point included)."""
+def load_study(path: Path, say: Callable[[str], None] | None = None) -> StudySpec:
+    """Read and validate a study file (every scenario at every point included); ``say`` is
+    told, before a long check of the points starts, how many there are."""
     source = str(path)
     data = read_yaml_mapping(path) if path.is_file() else _missing(path)
     unknown = sorted(set(map(str, data)) - _KEYS)
@@ -194,6 +205,9 @@ def load_study(path: Path) -> StudySpec:
         raise InputError(source, "tables", "Table 3 is for a study of one point (no grid)")
     if spec.size > MAX_RUNS:
         raise InputError(source, "", f"{spec.size} runs; at most {MAX_RUNS} in one study")
+    checked = len(spec.points) * len(spec.scenarios)
+    if say is not None and checked > ANNOUNCED_POINTS:
+        say(f"checking the scenario of each of {checked:,} points (a few ms each)")
     validate_points(spec)
     return spec
 
@@ -203,9 +217,10 @@ def validate_points(spec: StudySpec) -> dict[tuple[str, int], Scenario]:
     the study file, the point and the key."""
     resolved = {}
     for scenario in spec.scenarios:
+        layers = scenario_layers(scenario)  # its files read once for every point
         for number, point in enumerate(spec.points):
             try:
-                resolved[(scenario, number)] = load_scenario(scenario, point.as_dict())
+                resolved[(scenario, number)] = load_scenario(scenario, point.as_dict(), layers)
             except ScenarioError as error:
                 where = f"point {number} ({point.label}): {error.where}".rstrip(": ")
                 raise InputError(str(spec.source), where, error.problem) from None
@@ -292,8 +307,8 @@ def _points(source: str, grid: Any, points: Any) -> tuple[Point, ...]:
         if clash:
             raise InputError(source, f"points[{number}].{clash[0]}", "is also a grid key")
     size = len(points) * math.prod(len(values) for values in grid.values())
-    if size > MAX_RUNS:  # before the grid is expanded
-        raise InputError(source, "grid", f"{size} points; at most {MAX_RUNS} runs in one study")
+    if size > MAX_POINTS:  # before the grid is expanded
+        raise InputError(source, "grid", f"{size:,} points; at most {MAX_POINTS:,} in one study")
     combos = list(itertools.product(*grid.values()))
     expanded = [
         Point(tuple((str(k), v) for k, v in point.items()) + tuple(zip(map(str, grid), combo)))

@@ -122,7 +122,13 @@ BAD = [
         + ", map.eta: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95]"
         + ", fusion.broad_sigma_m: [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4]"
         + ", fusion.rho_threshold: [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]}\n",
-        "grid: 100000000 points; at most 1000000 runs in one study",
+        "grid: 100,000,000 points; at most 10,000 in one study",
+    ),
+    (  # a grid of 10^6 points (the runs' cap) took two minutes to check, saying nothing
+        "scenarios: [along]\ngrid: {"
+        + ", ".join(f"control.w_{w}: {list(range(1, 11))}" for w in GRID_WEIGHTS)
+        + ", map.eta: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95]}\n",
+        "grid: 1,000,000 points; at most 10,000 in one study",
     ),
     ("[1, 2]\n", "the file must hold a mapping"),
 ]
@@ -179,3 +185,18 @@ def test_a_points_faults_are_told_briefly_and_a_ramp_as_a_ramp():
     assert value_text("faults", ramp) == "support-1 SIM_GPS1_GLTCH_Z 0.1 to 0.5 in 5 steps, 10-15 s"
     apart = [dict(fault, at_s=fault["at_s"] * 2) for fault in ramp]  # not back to back
     assert value_text("faults", apart).count(";") == 4
+
+
+def test_a_study_of_many_points_says_so_before_it_checks_them(tmp_path):
+    path = tmp_path / "many.yaml"
+    path.write_text(
+        "scenarios: [along]\ngrid: {control.w_gnss: "
+        + str(list(range(1, 16)))
+        + ", map.eta: "
+        + str([round(0.05 * k, 2) for k in range(1, 16)])
+        + "}\n"
+    )
+    said: list[str] = []
+    spec = load_study(path, say=said.append)
+    assert len(spec.points) == 225
+    assert said == ["checking the scenario of each of 225 points (a few ms each)"]
