@@ -13,6 +13,7 @@ from mission.analysis.records_file import RecordsFile, read_records_file
 from mission.commands.common import add_run_scenario_option
 from mission.commands.run_files import previous_summary, run_scenario
 from mission.config.errors import InputError
+from mission.procs.disk_full import fresh, removed_if_disk_fills
 from mission.procs.outputs import check_output_dir
 
 
@@ -61,10 +62,12 @@ def analyze(args: argparse.Namespace) -> int:
         write_text_atomically(summary_path, json.dumps(merged, indent=2) + "\n")
     print(json.dumps(metrics, indent=2))  # stdout is the metrics alone; notes go to stderr
     if args.plots:
-        from mission.analysis.run_plot import RunLabel, plot_run
+        from mission.analysis.run_plot import FIGURES, RunLabel, plot_run
 
         label = RunLabel(scenario.name, previous.get("method"), previous.get("seed"))
-        for path in plot_run(trace, world, tlog.parent / "g", plots, label):
+        with removed_if_disk_fills(*fresh(plots, *(plots / name for name in FIGURES))):
+            written = plot_run(trace, world, tlog.parent / "g", plots, label)
+        for path in written:
             print(f"wrote {path}", file=sys.stderr)
     return 0
 

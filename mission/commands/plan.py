@@ -7,6 +7,7 @@ from pathlib import Path
 
 from mission.commands.common import add_scenario_argument, check_figure_path
 from mission.config.errors import InputError
+from mission.procs.disk_full import fresh, removed_if_disk_fills
 from mission.procs.outputs import check_output_dir
 
 
@@ -26,7 +27,7 @@ def add_parser(commands) -> None:
 
 def plan(args: argparse.Namespace) -> int:
     """``mission plan``."""
-    from mission.link.plan_files import write_plan
+    from mission.link.plan_files import vehicle_names, write_plan
     from mission.planning.planner import plan_supports
     from mission.planning.zone_placement import place_along, place_along_pair, place_wall
     from mission.world.model import World
@@ -36,7 +37,10 @@ def plan(args: argparse.Namespace) -> int:
     if args.plot is not None:
         check_figure_path(args.plot, "--plot", made=out)
     plan = plan_supports(world)
-    for path in write_plan(plan, world.scenario, out):
+    names = vehicle_names(world.scenario.task.supports)
+    with removed_if_disk_fills(*fresh(out, *(out / f"{name}.waypoints" for name in names))):
+        written = write_plan(plan, world.scenario, out)
+    for path in written:
         print(f"wrote {path}")
     if out.resolve() != Path(world.scenario.task.waypoints_dir).resolve():
         print(f"to fly it: task: {{waypoints_dir: {out.resolve()}}} in the scenario")

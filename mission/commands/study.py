@@ -10,6 +10,7 @@ from pathlib import Path
 from mission.commands.study_checks import check_study_outputs, checked_engine
 from mission.commands.study_verify import add_verify_arguments, verify_command
 from mission.config.errors import InputError
+from mission.procs.disk_full import fresh, removed_if_disk_fills
 from mission.procs.interrupts import StopRequest
 
 
@@ -112,8 +113,9 @@ def run_study_command(spec, out: Path, args: argparse.Namespace) -> int:
     engine = checked_engine(spec, out, args)
     # Ctrl-C and SIGTERM stop the study, even where it was started with SIGINT ignored (in the
     # background): then `kill -INT` cancels it as Ctrl-C would.
+    made = fresh(out, *([args.runs] if args.runs is not None else []))
     try:
-        with StopRequest():
+        with StopRequest(), removed_if_disk_fills(*made):  # a fresh study's start, not kept
             outcome = run_study(spec, out, engine, args.keep, runs_dir=args.runs, canary=True)
     except KeyboardInterrupt:
         print(f"study interrupted; finished runs are kept in {out}: run it again to resume")

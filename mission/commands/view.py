@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -36,6 +37,9 @@ def view(args: argparse.Namespace) -> int:
         raise InputError(str(run_dir / "gcs.tlog"), "", "is empty")
     if args.save is not None:
         check_output_file(args.save, "--save", (".rrd",))
+        # Rerun's own log lines would follow ours (a full disk: three of them); what went
+        # wrong is said on one line here. RUST_LOG set by the user is kept.
+        os.environ.setdefault("RUST_LOG", "off")
     previous = previous_summary(run_dir / "summary.json")
     scenario = run_scenario(run_dir, run_dir, previous, args.scenario)
     from mission.config.resources import map_shape

@@ -9,6 +9,8 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from mission.procs.disk_full import NO_SPACE_ERRNOS
+
 
 def write_atomically(path: Path, write: Callable[[str], None]) -> None:
     """Call ``write(temp_path)`` then move the result over ``path`` in one rename."""
@@ -19,6 +21,11 @@ def write_atomically(path: Path, write: Callable[[str], None]) -> None:
         write(temp)
         os.chmod(temp, 0o666 & ~current_umask())  # mkstemp makes it 0600
         os.replace(temp, path)
+    except OSError as error:
+        Path(temp).unlink(missing_ok=True)
+        if error.errno in NO_SPACE_ERRNOS and error.filename is None:  # name the file meant
+            raise OSError(error.errno, os.strerror(error.errno), str(path)) from error
+        raise
     except BaseException:
         Path(temp).unlink(missing_ok=True)
         raise

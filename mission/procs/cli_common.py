@@ -9,6 +9,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.procs.disk_full import EXIT_NO_SPACE, no_space_error, no_space_line
 
 EXIT_BAD_INPUT = 2
 
@@ -46,7 +47,8 @@ def program_name(module: str, script: str) -> str:
 
 
 def run_guarded(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
-    """Run ``main``; turn bad input into one line on stderr and status 2, Ctrl-C into 130."""
+    """Run ``main``; turn bad input into one line on stderr and status 2, a full disk into
+    one line and status 3 (:mod:`mission.procs.disk_full`), Ctrl-C into 130."""
     try:
         return main(argv)
     except InputError as error:
@@ -55,6 +57,12 @@ def run_guarded(main: Callable[[Sequence[str] | None], int], argv: Sequence[str]
     except KeyboardInterrupt:
         sys.stderr.write("interrupted\n")
         return 130
+    except OSError as error:
+        full = no_space_error(error)
+        if full is None:
+            raise
+        sys.stderr.write(no_space_line(full) + "\n")
+        return EXIT_NO_SPACE
 
 
 def parse_point(values: Sequence[float], flag: str) -> tuple[float, float, float]:

@@ -11,7 +11,9 @@ fails, or is interrupted, and die with this process if it is killed (``--exit-wi
 
 from __future__ import annotations
 
+import errno
 import json
+import os
 import re
 import socket
 import subprocess
@@ -30,6 +32,7 @@ from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
 from mission.procs.atomic import write_text_atomically
 from mission.procs.cli_common import child_environment
+from mission.procs.disk_full import EXIT_NO_SPACE
 from mission.procs.file_tail import FileTail
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
@@ -108,6 +111,9 @@ def run_mission(
                 gcs = _start_processes(options, scenario, children)
                 stall = StallWatch(options.out_dir / "gcs.tlog", options.stall_s)
                 _supervise(gcs, children, {"work"}, watcher, stop, stall)
+                if gcs.process.returncode == EXIT_NO_SPACE:  # its files could not be written
+                    full = errno.ENOSPC
+                    raise OSError(full, os.strerror(full), str(options.out_dir / "gcs.tlog"))
                 if gcs.process.returncode != 0:
                     status = gcs.process.returncode
                     raise RunFailed(f"ground_station exited with status {status}{_why(gcs.log)}")

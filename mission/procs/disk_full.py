@@ -1,0 +1,65 @@
+"""A full disk (or an exhausted quota): said on one line naming the file, exit status
+:data:`EXIT_NO_SPACE`, and what the command had begun to write removed, so no half output is
+left for a later command to mistake for a whole one."""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+NO_SPACE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT})
+EXIT_NO_SPACE = 3
+
+
+def no_space_error(error: BaseException | None) -> OSError | None:
+    """The OSError of a full disk in ``error`` or the exceptions it was raised from or
+    during (None: not a full disk)."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        seen.add(id(error))
+        if isinstance(error, OSError) and error.errno in NO_SPACE_ERRNOS:
+            return error
+        error = error.__cause__ or error.__context__
+    return None
+
+
+def no_space_line(error: OSError, fallback: str = "an output file") -> str:
+    """The one line that says so."""
+    return f"error: {error.filename or fallback}: no space left on device"
+
+
+@contextlib.contextmanager
+def removed_if_disk_fills(*paths: Path) -> Iterator[None]:
+    """Run the block; if it fails for a full disk, remove ``paths`` (files or folders this
+    command creates: pass only those that did not exist before it) and raise again."""
+    try:
+        yield
+    except BaseException as error:
+        if no_space_error(error) is not None:
+            for path in paths:
+                if path.is_dir() and not path.is_symlink():
+                    shutil.rmtree(path, ignore_errors=True)
+                else:
+                    path.unlink(missing_ok=True)
+        raise
+
+
+def filled_up(path: Path, margin_bytes: int = 1 << 20) -> bool:
+    """Whether the file system ``path`` is written to has less than ``margin_bytes`` free:
+    for a writer whose failure does not say why (Rerun's file sink: "File-writer thread shut
+    down prematurely")."""
+    place = path if path.is_dir() else path.parent
+    while not place.exists() and place != place.parent:
+        place = place.parent
+    try:
+        return shutil.disk_usage(place).free < margin_bytes
+    except OSError:
+        return False
+
+
+def fresh(*paths: Path) -> list[Path]:
+    """Those of ``paths`` that do not exist yet (what a command may remove again)."""
+    return [path for path in paths if not path.exists()]
