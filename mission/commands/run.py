@@ -18,7 +18,7 @@ from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import check_seed
 from mission.procs.disk_full import fresh, removed_if_disk_fills
-from mission.procs.outputs import check_output_dir
+from mission.procs.outputs import check_output_dir, remove_run_files, run_files_in
 from mission.runs.stall import DEFAULT_STALL_S
 
 
@@ -85,6 +85,12 @@ def add_parser(commands) -> None:
         choices=["auto", "web", "native"],
         help="stream the run to a Rerun viewer (auto: native with a display, else web)",
     )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="write over an earlier run in OUT (its files are removed first); without it, a "
+        "folder holding a run is refused",
+    )
     parser.add_argument("--exit-with-parent", action="store_true", help=argparse.SUPPRESS)
     parser.set_defaults(handler=run)
 
@@ -107,7 +113,16 @@ def run(args: argparse.Namespace) -> int:
     stamp = time.strftime("%Y%m%d-%H%M%S")
     out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
     check_output_dir(out, "--out")
+    earlier = run_files_in(out)
+    if earlier and not args.force:
+        raise InputError(
+            "command line",
+            "--out",
+            f"{str(out)!r} holds a run ({earlier[0].name}): give a new folder, or --force to "
+            "write over it",
+        )
     options = _run_options(args, out, speedup)
+    remove_run_files(out)  # --force: the earlier run's files, once every check has passed
     print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
     live = None
     try:

@@ -7,6 +7,7 @@ nothing else is created."""
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -59,3 +60,29 @@ def _check_writable_ancestor(path: Path, flag: str) -> None:
         )
     if not os.access(ancestor, os.W_OK | os.X_OK) or not _can_make_in(ancestor):
         raise InputError("command line", flag, f"{str(path)!r}: cannot write in {str(ancestor)!r}")
+
+
+# What a run writes into its folder (mission run --out): a folder holding any of them holds a
+# run, which a new one would mix with or overwrite.
+RUN_FILES = ("gcs.tlog", "records.jsonl", "summary.json", "link.json", "ground_station.log")
+RUN_FILE_PATTERNS = ("work.log", "support-*.log", "viewer.log", "g", "plots")
+
+
+def run_files_in(folder: Path) -> list[Path]:
+    """The files and folders of an earlier run in ``folder`` (none if it is not a folder)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    found = [folder / name for name in RUN_FILES if (folder / name).exists()]
+    for pattern in RUN_FILE_PATTERNS:
+        found += sorted(folder.glob(pattern))
+    return found
+
+
+def remove_run_files(folder: Path) -> None:
+    """Remove an earlier run's files from ``folder`` (what else it holds stays)."""
+    for path in run_files_in(folder):
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        else:
+            path.unlink(missing_ok=True)

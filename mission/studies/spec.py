@@ -214,7 +214,8 @@ def load_study(path: Path, say: Callable[[str], None] | None = None) -> StudySpe
 
 def validate_points(spec: StudySpec) -> dict[tuple[str, int], Scenario]:
     """Every (scenario, point number) resolved as a scenario; the first bad one raises, naming
-    the study file, the point and the key."""
+    the study file, the point and the key (the scenario's file where the point changes
+    nothing)."""
     resolved = {}
     for scenario in spec.scenarios:
         layers = scenario_layers(scenario)  # its files read once for every point
@@ -222,6 +223,8 @@ def validate_points(spec: StudySpec) -> dict[tuple[str, int], Scenario]:
             try:
                 resolved[(scenario, number)] = load_scenario(scenario, point.as_dict(), layers)
             except ScenarioError as error:
+                if not point.overrides:  # the scenario's own file is at fault: it is named
+                    raise
                 where = f"point {number} ({point.label}): {error.where}".rstrip(": ")
                 raise InputError(str(spec.source), where, error.problem) from None
             except ValueError as error:

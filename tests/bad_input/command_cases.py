@@ -12,6 +12,7 @@ from tests.bad_input.builders import (
     plain_file,
     raw_file,
     results,
+    scenario_file,
     study_file,
     tlog_run,
 )
@@ -24,7 +25,17 @@ COMMAND_CASES = [
     ("run-link-delay", lambda t: [*RUN, "--link-delay-ms", "-3"], ["--link-delay-ms"]),
     ("run-observer", lambda t: [*RUN, "--observer", "qgc"], ["--observer"]),
     ("run-stall", lambda t: [*RUN, "--stall-s", "-5"], ["--stall-s", ">= 0"]),
+    (  # an earlier run's folder is not written over without a word
+        "run-out-holds-a-run",
+        lambda t: [*RUN, "--out", str(tlog_run(t, b"\xfe" * 40, "{}"))],
+        ["--out", "holds a run", "--force"],
+    ),
     ("batch-trials", lambda t: ["batch", "--trials", "0"], ["--trials"]),
+    (  # a bad scenario named as the file it is, not as "command line: point 0 (defaults)"
+        "batch-bad-scenario",
+        lambda t: ["batch", str(scenario_file(t, "control: {horizon_steps: -1}\n"))],
+        ["bad.yaml: control.horizon_steps", "must be at least 1"],
+    ),
     ("batch-jobs", lambda t: ["batch", "--jobs", "0"], ["--jobs"]),
     ("batch-speedup-alone", lambda t: ["batch", "--speedup", "10"], ["--speedup", "--realtime"]),
     ("batch-speedup-zero", lambda t: ["batch", "--realtime", "--speedup", "0"], ["--speedup"]),
