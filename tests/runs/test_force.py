@@ -28,6 +28,7 @@ def test_force_writes_over_an_earlier_run_and_keeps_nothing_of_it(short_run, tmp
     assert not (out / "plots").exists() and not (out / "support-7.log").exists()
     assert (out / "notes.txt").exists()
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["decisions_digest"] == json.loads((earlier / "summary.json").read_text())[
-        "decisions_digest"
-    ]
+    assert (
+        summary["decisions_digest"]
+        == json.loads((earlier / "summary.json").read_text())["decisions_digest"]
+    )
