@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import sys
 import time
 from collections.abc import Sequence
@@ -149,6 +150,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         g_snapshots=args.g_snapshots,
     )
     station = GroundStation(world, config)
+    # SIGTERM (a run stopped early) ends it as Ctrl-C does: through station.close(), which
+    # waits for its MPC helper (killed at once, the helper was left a zombie for init to reap)
+    signal.signal(signal.SIGTERM, _interrupted)
     host, port = station.links.endpoint.address
     print(f"ground station listening on {host}:{port}", file=sys.stderr, flush=True)
     try:
@@ -165,6 +169,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     write_text_atomically(out / "summary.json", json.dumps(summary, indent=2) + "\n")
     print(json.dumps(summary))
     return 0
+
+
+def _interrupted(*_: object) -> None:
+    raise KeyboardInterrupt
 
 
 def _vehicle_addresses(args, supports: int) -> dict:

@@ -398,6 +398,32 @@ def test_ctrl_c_stops_every_process_of_a_run_and_keeps_its_logs(tmp_path, sigint
     assert (out / "gcs.tlog").stat().st_size > 0 and "steps to t=" in (out / "work.log").read_text()
 
 
+def test_a_signal_to_the_run_alone_leaves_no_zombie_helper(tmp_path):
+    """SIGINT to the run's own process (kill -INT, not the group): it stops the ground
+    station with SIGTERM, which ends it as Ctrl-C does, so it waits for its MPC helper (it
+    died at once before, and the helper lingered <defunct> until init reaped it)."""
+    out = tmp_path / "signalled"
+    run = _start_in_own_group(out)
+    try:
+        _wait_for_cycles(out, 5)
+        helpers = [pid for pid in _processes_of(out) if _name_of(pid) == "gcs-mpc-helper"]
+        assert len(helpers) == 1
+        os.kill(run.pid, signal.SIGINT)
+        stdout, stderr = run.communicate(timeout=60)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    assert run.returncode == 130, stdout + stderr
+    assert not Path(f"/proc/{helpers[0]}").exists(), "the helper is left, a zombie"
+
+
+def _name_of(pid: str) -> str:
+    try:
+        return Path(f"/proc/{pid}/comm").read_text().strip()
+    except OSError:
+        return ""
+
+
 def test_a_killed_run_takes_its_processes_with_it(tmp_path):
     """SIGKILL gives the run no chance to stop anything: its children notice their parent's
     death (and the helper its station's) and end by themselves."""
