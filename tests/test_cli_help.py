@@ -53,14 +53,15 @@ def test_a_default_of_zero_is_shown_and_an_unset_option_is_not():
 def test_the_commands_are_console_scripts_as_sitl_tools_are():
     from importlib.metadata import entry_points
 
-    import ground_station.cli
-    import mission.cli
-    import vehicle_sim.cli
+    import ground_station.__main__
+    import mission.__main__
+    import vehicle_sim.__main__
 
+    # the scripts enter as python -m does: through __main__, which pins the numerics first
     scripts = {e.name: e for e in entry_points(group="console_scripts")}
     for name, function in [
-        ("mission", mission.cli.entry_point),
-        ("mission-vehicle", vehicle_sim.cli.entry_point),
-        ("mission-ground-station", ground_station.cli.entry_point),
+        ("mission", mission.__main__.main),
+        ("mission-vehicle", vehicle_sim.__main__.main),
+        ("mission-ground-station", ground_station.__main__.main),
     ]:
         assert scripts[name].load() is function

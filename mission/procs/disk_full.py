@@ -47,19 +47,6 @@ def removed_if_disk_fills(*paths: Path) -> Iterator[None]:
         raise
 
 
-def filled_up(path: Path, margin_bytes: int = 1 << 20) -> bool:
-    """Whether the file system ``path`` is written to has less than ``margin_bytes`` free:
-    for a writer whose failure does not say why (Rerun's file sink: "File-writer thread shut
-    down prematurely")."""
-    place = path if path.is_dir() else path.parent
-    while not place.exists() and place != place.parent:
-        place = place.parent
-    try:
-        return shutil.disk_usage(place).free < margin_bytes
-    except OSError:
-        return False
-
-
 def fresh(*paths: Path) -> list[Path]:
     """Those of ``paths`` that do not exist yet (what a command may remove again)."""
     return [path for path in paths if not path.exists()]

@@ -61,15 +61,13 @@ class LiveView:
             os.nice(NICENESS)  # every child is started by now: this process alone
             self._feed = RunFeed(self.out_dir, self.scenario)
         if self._rec is None:
-            from mission.viewer.recording import open_recording
+            from mission.viewer.recording import Recording
 
             url = self.viewer.grpc_url if self.viewer else None
-            self._rec = open_recording(self.out_dir.name, self._feed.scene, url, self.save)
-        from mission.viewer.send import send_frame
-
+            self._rec = Recording(self.out_dir.name, self._feed.scene, url, self.save)
         frame = self._feed.read(final)
         if frame:
-            send_frame(self._rec, frame, self._feed.scene)
+            self._rec.send(frame)
 
     def finish(self) -> None:
         """The run is over: stream the rest and complete the recording."""
@@ -85,10 +83,8 @@ class LiveView:
 
     def _close_recording(self) -> None:
         if self._rec is not None:
-            from mission.viewer.recording import close_recording
-
             rec, self._rec = self._rec, None
             try:
-                close_recording(rec)
+                rec.close()
             except Exception as error:  # as in poll: never at the run's expense
                 print(f"live view stopped: {error}", file=sys.stderr, flush=True)

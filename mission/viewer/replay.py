@@ -3,14 +3,13 @@ or the web viewer on 127.0.0.1) and/or a recording file."""
 
 from __future__ import annotations
 
-import errno
 import os
 import sys
 from pathlib import Path
 from typing import Literal
 
 from mission.config.settings import Scenario
-from mission.procs.disk_full import filled_up, fresh, removed_if_disk_fills
+from mission.procs.disk_full import fresh, removed_if_disk_fills
 from mission.procs.interrupts import StopRequest
 from mission.viewer.feed import RunFeed
 from mission.viewer.process import ViewerProcess, start_viewer, stop_viewer
@@ -32,19 +31,14 @@ def replay_run(
     feed = RunFeed(run_dir, scenario)
     process = start_viewer(viewer) if viewer else None
     try:
-        from mission.viewer.recording import close_recording, open_recording
-        from mission.viewer.send import send_frame
+        from mission.viewer.recording import Recording
 
         with removed_if_disk_fills(*fresh(*([save] if save is not None else []))):
+            rec = Recording(run_dir.name, feed.scene, process and process.grpc_url, save)
             try:
-                rec = open_recording(run_dir.name, feed.scene, process and process.grpc_url, save)
-                send_frame(rec, feed.read(final=True), feed.scene)
-                close_recording(rec)
-            except RuntimeError:  # Rerun's file sink gave up: say why where it was a full disk
-                if save is not None and filled_up(save):
-                    full = errno.ENOSPC
-                    raise OSError(full, os.strerror(full), str(save)) from None
-                raise
+                rec.send(feed.read(final=True))
+            finally:
+                rec.close()
         if save is not None:
             print(f"wrote {save} (open it with: rerun {save})", flush=True)
         if process is not None:
