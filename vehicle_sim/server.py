@@ -45,6 +45,7 @@ PEER_EXPIRY_WALL_S = 30.0
 MAX_WAIT_WALL_S = 0.1
 IDLE_HEARTBEAT_WALL_S = 1.0
 MAX_TICK_JUMP_S = 60.0  # a clock tick may advance at most this far (guards against garbage)
+MAX_JOIN_S = 1e6  # s: a run joined later than 11 days in is no run (2^32 ms is 49 days)
 
 
 @dataclass(frozen=True)
@@ -232,6 +233,9 @@ class VehicleServer:
                 self.stats.resent_steps += 1
             return
         if not self._started and vehicle.steps == 0 and time_s > vehicle.step_s + 1e-9:
+            if time_s > MAX_JOIN_S:  # SYSTEM_TIME's time_boot_ms (uint32 ms) would overflow
+                vehicle.counters.reject("clock tick too far ahead")
+                return
             vehicle.join_clock(time_s)  # a vehicle (re)started into a running mission
         if not 0 < time_s - vehicle.sim_time_s <= MAX_TICK_JUMP_S:
             if time_s > vehicle.sim_time_s:

@@ -30,6 +30,7 @@ from mission.analysis.spread import spread
 from mission.analysis.trace import RunTrace
 from mission.analysis.tracking import tracking_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, truth_time
+from mission.config.errors import InputError
 from mission.config.settings import Scenario
 from mission.link.fast_decode import FastDecoder
 from mission.link.statustext import StatusChunks
@@ -69,8 +70,15 @@ def _mavutil_messages(tlog: Path) -> Iterator[Any]:
     """Every message of a tlog through pymavlink's tolerant reader."""
     from pymavlink import mavutil  # 0.1 s to import (every dialect); the fast path needs none
 
-    log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega", robust_parsing=True)
-    return iter(log.recv_match, None)
+    try:
+        log = mavutil.mavlink_connection(str(tlog), dialect="ardupilotmega", robust_parsing=True)
+        while (message := log.recv_match()) is not None:
+            yield message
+    except (AttributeError, TypeError, ValueError, IndexError, KeyError) as error:
+        # pymavlink's reader itself failed on the bytes (not one of ours): a damaged file
+        raise InputError(
+            str(tlog), "", f"is damaged: pymavlink cannot read it ({type(error).__name__})"
+        ) from None
 
 
 def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:

@@ -145,5 +145,7 @@ def parse_record(line: bytes | str) -> tuple[dict[str, Any] | None, str | None]:
         record = json.loads(line)
     except ValueError:  # UnicodeDecodeError included
         return None, "is not JSON"
+    except RecursionError:
+        return None, "is nested too deeply to be a record"
     problem = record_problem(record)
     return (record, None) if problem is None else (None, problem)

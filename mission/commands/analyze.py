@@ -9,7 +9,7 @@ import json
 import sys
 from pathlib import Path
 
-from mission.analysis.records_file import RecordsFile, read_records_file
+from mission.analysis.records_file import RecordsFile, RunShape, read_records_file
 from mission.commands.common import add_run_scenario_option
 from mission.commands.run_files import previous_summary, run_scenario
 from mission.config.errors import InputError
@@ -47,7 +47,8 @@ def analyze(args: argparse.Namespace) -> int:
     plots = tlog.parent / "plots"
     if args.plots:
         _check_plots(plots)
-    records = _records_beside(tlog)  # a damaged file refused before the tlog is read
+    shape = RunShape.of(scenario, previous)
+    records = _records_beside(tlog, shape)  # a damaged file refused before the tlog is read
     trace, world = read_tlog(tlog, scenario), World(scenario)
     metrics = metrics_of(trace, world, tlog.parent, scenario)
     if not metrics["control_cycles"]:
@@ -82,16 +83,27 @@ def _check_plots(plots: Path) -> None:
             raise InputError("command line", "--plots", f"{plots / name} is a directory")
 
 
-def _records_beside(tlog: Path) -> RecordsFile | None:
+def _records_beside(tlog: Path, shape: RunShape) -> RecordsFile | None:
     """The run's records.jsonl, checked line by line (None: the tlog has none beside it)."""
     path = tlog.parent / "records.jsonl"
-    return read_records_file(path) if path.is_file() else None
+    if not path.exists() and not path.is_symlink():
+        return None
+    if not path.is_file():
+        raise InputError(str(path), "", "is not a regular file")
+    return read_records_file(path, shape)
 
 
 def _check_records_hold_the_cycles(path: Path, records: RecordsFile, metrics: dict) -> None:
     """Records of fewer cycles than the tlog's (one fewer where the station stopped between
     a cycle's commands and its record) were cut short or emptied: the summary is kept."""
     cycles, held = metrics["control_cycles"], len(records.records)
+    if held > cycles:
+        raise InputError(
+            str(path),
+            "",
+            f"holds {held} control cycles' records where the tlog has {cycles}: records of "
+            "another run, or added? summary.json is not rewritten",
+        )
     if held < cycles - 1:
         raise InputError(
             str(path),

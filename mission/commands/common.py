@@ -66,11 +66,13 @@ def preflight(scenario) -> None:
         check_plan_files,
         check_recall_in_time,
         check_work_plan_matches,
+        check_work_waypoints_clear,
     )
     from mission.link.plan_files import vehicle_names
     from mission.world.model import KnownWorld
 
     world = KnownWorld(scenario)
+    check_work_waypoints_clear(world)
     names = vehicle_names(scenario.task.supports)
     check_plan_files(world, Path(scenario.task.waypoints_dir), names)
     check_work_plan_matches(world, Path(scenario.task.waypoints_dir))

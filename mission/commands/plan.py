@@ -38,8 +38,15 @@ def plan(args: argparse.Namespace) -> int:
         check_figure_path(args.plot, "--plot", made=out)
     plan = plan_supports(world)
     names = vehicle_names(world.scenario.task.supports)
-    with removed_if_disk_fills(*fresh(out, *(out / f"{name}.waypoints" for name in names))):
+    outputs = [out, *(out / f"{name}.waypoints" for name in names)]
+    outputs += [args.plot] if args.plot is not None else []
+    with removed_if_disk_fills(*fresh(*outputs)):  # the plan and its figure, or neither
         written = write_plan(plan, world.scenario, out)
+        if args.plot is not None:
+            from mission.planning.plan_plot import plot_plan
+
+            plot_plan(world, plan, args.plot)
+            written.append(args.plot)
     for path in written:
         print(f"wrote {path}")
     if out.resolve() != Path(world.scenario.task.waypoints_dir).resolve():
@@ -72,11 +79,6 @@ def plan(args: argparse.Namespace) -> int:
                 )
         except ValueError as reason:
             print(f"two Along zones: {reason}")
-    if args.plot is not None:
-        from mission.planning.plan_plot import plot_plan
-
-        plot_plan(world, plan, args.plot)
-        print(f"wrote {args.plot}")
     return 0
 
 

@@ -17,7 +17,7 @@ from mission.commands.common import (
 from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import check_seed
-from mission.procs.disk_full import fresh, removed_if_disk_fills
+from mission.procs.disk_full import fresh, no_space_error, removed_if_disk_fills
 from mission.procs.outputs import check_output_dir, remove_run_files, run_files_in
 from mission.runs.stall import DEFAULT_STALL_S
 
@@ -127,8 +127,14 @@ def run(args: argparse.Namespace) -> int:
     live = None
     try:
         live = _live_view(args.view, out, scenario) if args.view else None
-        with removed_if_disk_fills(*fresh(out)):  # a run that could not be written is none
-            summary = run_mission(options, scenario, live)
+        made = fresh(out)
+        try:
+            with removed_if_disk_fills(*made):  # a run that could not be written is none
+                summary = run_mission(options, scenario, live)
+        except OSError as error:
+            if not made and no_space_error(error) is not None:
+                remove_run_files(out)  # an --out that existed (--force): this run's files
+            raise
         print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
         if live is not None and live.viewer is not None:
             from mission.viewer.replay import wait_for_viewer

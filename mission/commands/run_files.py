@@ -17,15 +17,30 @@ def run_scenario(given: Path, run_dir: Path, previous: dict, explicit: str | Non
     source = previous.get("scenario_source")
     if source is not None and not Path(source).is_file():
         source = None  # resolved on another machine (a Ray node's temporary folder)
-    scenario_name = (
-        explicit
-        or (str(beside) if beside.is_file() else None)
-        or source
-        or previous.get("scenario")
-    )
+    flown = (str(beside) if beside.is_file() else None) or source or previous.get("scenario")
+    scenario_name = explicit or flown
     if scenario_name is None:
         raise InputError(str(given), "--scenario", "unknown scenario: give --scenario")
-    return load_scenario(scenario_name)
+    scenario = load_scenario(scenario_name)
+    if explicit is not None and flown is not None:
+        _check_same_flight(scenario, load_scenario(flown), explicit, flown)
+    return scenario
+
+
+def _check_same_flight(given, flown, explicit: str, where: str) -> None:
+    """``--scenario`` may change what the run is judged by (its zones), not what it flew:
+    its supports, the work UAV's path and the control period are the run's own."""
+    for field, mine, theirs in (
+        ("task.supports", given.task.supports, flown.task.supports),
+        ("task.work_waypoints_m", given.task.work_waypoints_m, flown.task.work_waypoints_m),
+        ("control.t_cont_s", given.control.t_cont_s, flown.control.t_cont_s),
+    ):
+        if mine != theirs:
+            raise InputError(
+                "command line",
+                "--scenario",
+                f"{explicit}'s {field} is not the run's ({where}): the run did not fly it",
+            )
 
 
 def previous_summary(path: Path) -> dict:

@@ -82,6 +82,8 @@ def study(args: argparse.Namespace) -> int:
         return verify_command(spec, args)
     if args.against is not None:
         raise InputError("command line", "--against", "is for --verify")
+    if args.draw_seed is not None:
+        raise InputError("command line", "--draw-seed", "is for --verify N")
     out = args.out or Path("results") / spec.name
     if args.report_only:
         return _report_only(spec, out, args.historical)

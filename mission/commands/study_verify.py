@@ -27,8 +27,7 @@ def add_verify_arguments(parser: argparse.ArgumentParser) -> None:
         "--draw-seed",
         type=int,
         metavar="S",
-        default=0,
-        help="with --verify N: the seed of the draw of rows",
+        help="with --verify N: the seed of the draw of rows (default: 0)",
     )
 
 
@@ -66,7 +65,7 @@ def verify_command(spec, args: argparse.Namespace) -> int:
     try:
         with StopRequest():
             outcome = run_verify(
-                spec, args.against, count, out, engine, runs_dir=args.runs, seed=args.draw_seed
+                spec, args.against, count, out, engine, runs_dir=args.runs, seed=args.draw_seed or 0
             )
     except KeyboardInterrupt:
         print(f"verification interrupted; the runs made are kept in {out}")

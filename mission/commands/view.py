@@ -42,12 +42,14 @@ def view(args: argparse.Namespace) -> int:
         os.environ.setdefault("RUST_LOG", "off")
     previous = previous_summary(run_dir / "summary.json")
     scenario = run_scenario(run_dir, run_dir, previous, args.scenario)
+    from mission.analysis.records_file import RunShape
     from mission.config.resources import map_shape
     from mission.viewer.check import check_run_files
     from mission.viewer.process import ViewerFailed
     from mission.viewer.replay import replay_run, viewer_kind
 
-    for warning in check_run_files(run_dir, map_shape(scenario), previous):
+    shape = RunShape.of(scenario, previous)
+    for warning in check_run_files(run_dir, map_shape(scenario), previous, shape):
         print(f"warning: {warning}", file=sys.stderr)
 
     viewer = viewer_kind(args.web) if args.web or args.save is None else None

@@ -10,7 +10,9 @@ every vehicle dying at its first step.
   second-order loop s^2 tau + s + K: its natural frequency sqrt(K / tau) at most
   :data:`MAX_LOOP_FREQUENCY_STEPS` / h (it runs once a substep, its command held) and its
   damping 1 / (2 sqrt(K tau)) at least :data:`MIN_RATE_LOOP_DAMPING`.
-- The cascade runs each loop slower than the one inside it: position, velocity, attitude, rate.
+- The cascade runs each loop at least :data:`MIN_CASCADE_RATIO` times slower than the one
+  inside it: position, velocity, attitude, rate (closer, the loops couple: 15/30/60/99 per s
+  passes every check above and crashes).
 """
 
 from __future__ import annotations
@@ -19,12 +21,18 @@ import itertools
 import math
 
 from mission.config.checks import require
-from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
+from mission.config.multicopter_settings import (
+    STANDARD_GRAVITY,
+    AutopilotSettings,
+    MulticopterSettings,
+)
 
 MAX_RATE_HZ = 2000.0
 STEPS_PER_TIME_CONSTANT = 2.0
 MAX_LOOP_FREQUENCY_STEPS = 0.5  # the rate loop's natural frequency times h
 MIN_RATE_LOOP_DAMPING = 0.2
+MAX_THRUST_TO_WEIGHT = 10.0
+MIN_CASCADE_RATIO = 2.5  # the defaults: 2.5, 3.2, 3.1 (a rule of thumb is 3-5)
 
 
 def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
@@ -64,13 +72,26 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
         f"(at least {MIN_RATE_LOOP_DAMPING:g}: K tau at most "
         f"{1 / (4 * MIN_RATE_LOOP_DAMPING**2):g})",
     )
+    hover = body.mass_kg * STANDARD_GRAVITY / 4
+    require(
+        body.rotor_thrust_max_n <= MAX_THRUST_TO_WEIGHT * hover,
+        "multicopter.rotor_thrust_max_n",
+        f"must be at most {MAX_THRUST_TO_WEIGHT:g} times a quarter of the weight "
+        f"({hover:.2f} N; a racing quadrotor's thrust-to-weight)",
+    )
+    require(
+        body.rotor_torque_max_n_m <= body.rotor_thrust_max_n * body.arm_m,
+        "multicopter.rotor_torque_max_n_m",
+        "must be at most rotor_thrust_max_n x arm_m (a propeller's drag torque is a few per "
+        "cent of its thrust's moment)",
+    )
     cascade = ("position", "velocity", "attitude", "rate")
     for outer, inner in itertools.pairwise(cascade):
         slow = getattr(loops, f"{outer}_gain_per_s")
         fast = getattr(loops, f"{inner}_gain_per_s")
         require(
-            slow < fast,
+            MIN_CASCADE_RATIO * slow <= fast,
             f"autopilot.{outer}_gain_per_s",
-            f"{slow:g} must be below {inner}_gain_per_s ({fast:g}): a loop slower than the "
-            "one it commands",
+            f"{slow:g} must be below {inner}_gain_per_s ({fast:g}) by a factor of at least "
+            f"{MIN_CASCADE_RATIO:g}: a loop too close to the one it commands couples with it",
         )

@@ -21,12 +21,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from mission.config.checks import at_most as _at_most
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
 
 MIN_RATE_HZ = 50.0  # below this the motors' 0.05 s lag is not resolved
 STANDARD_GRAVITY = 9.80665
+MAX_MASS_KG = 100.0
+MIN_TILT_DEG = 5.0
 
 
 @dataclass(frozen=True)
@@ -67,6 +70,7 @@ class MulticopterSettings:
             "breaks the triangle inequality of a rigid body's principal moments",
         )
         _require(self.rate_hz >= MIN_RATE_HZ, "rate_hz", f"must be at least {MIN_RATE_HZ:g} Hz")
+        _require(self.mass_kg <= MAX_MASS_KG, "mass_kg", f"must be at most {MAX_MASS_KG:g} kg")
         hover = self.mass_kg * STANDARD_GRAVITY / 4
         _require(
             self.rotor_thrust_max_n > hover,
@@ -119,4 +123,10 @@ class AutopilotSettings:
         _positive(
             self, "rate_gain_per_s", "acceleration_max_m_s2", "tilt_max_deg", "rate_max_rad_s"
         )
-        _require(self.tilt_max_deg < 90, "tilt_max_deg", "must be less than 90 degrees")
+        _require(
+            MIN_TILT_DEG <= self.tilt_max_deg < 90,
+            "tilt_max_deg",
+            f"must be in [{MIN_TILT_DEG:g}, 90) degrees (less leaves no sideways thrust to fly)",
+        )
+        _at_most(self, 1.0, "a navigation filter's velocity error", "velocity_bias_m_s")
+        _at_most(self, 1.0, "a navigation filter's velocity error", "velocity_noise_m_s")

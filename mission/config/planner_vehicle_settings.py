@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from mission.config.checks import as_parameter as _as_parameter
+from mission.config.checks import at_most as _at_most
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
@@ -33,6 +35,10 @@ class PlannerSettings:
         _non_negative(self, "min_separation_m", "clearance_m", "min_altitude_m")
         _require(self.max_range_fraction <= 1, "max_range_fraction", "must be at most 1")
         _require(self.rounds >= 1, "rounds", "must be at least 1")
+
+
+MIN_HEARTBEAT_HZ = 0.2
+MAX_STREAM_HZ = 100.0
 
 
 @dataclass(frozen=True)
@@ -64,6 +70,26 @@ class VehicleSettings:
         _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
         _positive(self, "lockstep_timeout_wall_s", "truth_timeout_wall_s", "mission_timeout_wall_s")
         _require(self.mission_retries >= 0, "mission_retries", "must not be negative")
+        _as_parameter("tracking_noise_m", self.tracking_noise_m, "SIM_TRACK_NOISE")
+        _as_parameter("failsafe_s", self.failsafe_s, "FS_GCS_TIMEOUT")
+        _as_parameter("sensor_hz", round(self.sensor_hz), "SIM_GPS1_HZ", " (rounded)")
+        _require(
+            self.heartbeat_hz >= MIN_HEARTBEAT_HZ,
+            "heartbeat_hz",
+            f"must be at least {MIN_HEARTBEAT_HZ:g} Hz (a ground station takes 5 s without "
+            "one for a lost link)",
+        )
+        _require(
+            round(self.status_hz) >= 1, "status_hz", "must round to at least 1 Hz (SR0_EXT_STAT)"
+        )
+        _at_most(self, MAX_STREAM_HZ, "a message every 10 ms", "heartbeat_hz", "status_hz")
+        for name, least in (("lockstep_timeout_wall_s", 0.1), ("mission_timeout_wall_s", 0.05)):
+            _require(
+                getattr(self, name) >= least,
+                name,
+                f"must be at least {least:g} s of wall time (a loaded machine's scheduling "
+                "alone takes that long)",
+            )
         _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")
         if self.dynamics == "multicopter":
             check_flyable(self.multicopter, self.autopilot)

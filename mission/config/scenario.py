@@ -141,14 +141,42 @@ def _load_layers(path: Path, depth: int) -> dict[str, Any]:
 # libyaml's parser when PyYAML has it (10x faster: every process reads the scenario at
 # start-up), with the same safe constructors; the pure-Python one otherwise, and for errors,
 # whose wording is its own ("expected ',' or ']', but got '<stream end>'").
-_FAST_SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+# Both refuse a key written twice in one mapping (YAML says keys are unique; PyYAML keeps the
+# last, so a second, empty ``faults:`` would silently drop the first).
+
+
+def _unique_keys(loader: type) -> type:
+    class UniqueKeyLoader(loader):  # type: ignore[misc, valid-type]
+        def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+            if isinstance(node, yaml.MappingNode):
+                seen: set[Any] = set()
+                for key_node, _ in node.value:
+                    if key_node.tag == "tag:yaml.org,2002:merge":
+                        continue
+                    key = self.construct_object(key_node, deep=True)
+                    try:
+                        duplicate = key in seen
+                    except TypeError:  # an unhashable key: the constructor's own error follows
+                        continue
+                    if duplicate:
+                        raise yaml.constructor.ConstructorError(
+                            None, None, f"the key {key!r} is written twice", key_node.start_mark
+                        )
+                    seen.add(key)
+            return super().construct_mapping(node, deep=deep)
+
+    return UniqueKeyLoader
+
+
+_FAST_SAFE_LOADER = _unique_keys(getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+_SAFE_LOADER = _unique_keys(yaml.SafeLoader)
 
 
 def _safe_load(text: str) -> Any:
     try:
         return yaml.load(text, Loader=_FAST_SAFE_LOADER)
     except yaml.YAMLError:
-        return yaml.load(text, Loader=yaml.SafeLoader)
+        return yaml.load(text, Loader=_SAFE_LOADER)
 
 
 def read_yaml_mapping(path: Path) -> dict[str, Any]:

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import Literal
 
+from mission.config.checks import as_parameter as _as_parameter
+from mission.config.checks import at_most as _at_most
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
@@ -25,6 +27,7 @@ from mission.config.role_settings import (
     check_roles,
     check_waypoints,
 )
+from mission.config.sensor_settings import CameraSettings, GnssSettings, SkySettings
 from mission.config.wind_settings import WindSettings
 
 Vec3 = tuple[float, float, float]
@@ -110,6 +113,9 @@ class StructureSettings:
         )
 
 
+MAX_ZONE_OFFSET_M = 1000.0
+
+
 @dataclass(frozen=True)
 class Zone:
     """A multipath-affected space: GNSS fixes inside it are offset by ``offset_m``."""
@@ -121,6 +127,12 @@ class Zone:
 
     def __post_init__(self) -> None:
         Box(self.min_m, self.max_m)
+        _require(
+            all(math.isfinite(v) and abs(v) <= MAX_ZONE_OFFSET_M for v in self.offset_m),
+            "offset_m",
+            f"each component must be at most {MAX_ZONE_OFFSET_M:g} m (NLOS errors stay within "
+            "hundreds of metres; a fix beyond is no longer near the Earth)",
+        )
 
     @property
     def box(self) -> Box:
@@ -159,65 +171,6 @@ class WorldSettings:
 
 
 @dataclass(frozen=True)
-class SkySettings:
-    """Satellite sky: a table of azimuth/elevation rows and the epoch to use."""
-
-    table: str
-    epoch_utc: str
-    elevation_mask_deg: float
-    constellations: tuple[str, ...]
-
-    def __post_init__(self) -> None:
-        try:
-            datetime.fromisoformat(self.epoch_utc.replace("Z", "+00:00"))
-        except ValueError:
-            raise FieldProblem(
-                "epoch_utc", f"not an ISO-8601 time like 2021-10-01T03:00:00Z: {self.epoch_utc!r}"
-            ) from None
-        _require(
-            0 <= self.elevation_mask_deg < 90,
-            "elevation_mask_deg",
-            f"must be in [0, 90), got {self.elevation_mask_deg}",
-        )
-        _require(bool(self.constellations), "constellations", "must name at least one")
-        for i, code in enumerate(self.constellations):
-            _require(
-                len(code) == 1 and code.isalpha() and code.isupper(),
-                f"constellations[{i}]",
-                f"must be a one-letter system code such as G or R, got {code!r}",
-            )
-
-
-@dataclass(frozen=True)
-class GnssSettings:
-    """GNSS of a support UAV (paper 3.1.1)."""
-
-    sigma_uere_m: float
-
-    def __post_init__(self) -> None:
-        _positive(self, "sigma_uere_m")
-
-
-@dataclass(frozen=True)
-class CameraSettings:
-    """Relative observation by a support UAV's camera (paper 3.1.2).
-
-    sigma_d(d) = sigma_d_a2_per_m d^2 + sigma_d_a1 d + sigma_d_a0_m.
-    """
-
-    sigma_d_a2_per_m: float
-    sigma_d_a1: float
-    sigma_d_a0_m: float
-    sigma_elevation_deg: float
-    sigma_azimuth_deg: float
-    range_m: float
-
-    def __post_init__(self) -> None:
-        _non_negative(self, "sigma_d_a2_per_m", "sigma_d_a1")
-        _positive(self, "sigma_d_a0_m", "sigma_elevation_deg", "sigma_azimuth_deg", "range_m")
-
-
-@dataclass(frozen=True)
 class FusionSettings:
     """Selective fusion (paper 3.2.1) with the candidate-particle sets of MODEL.md."""
 
@@ -253,6 +206,10 @@ class MapSettings:
         _non_negative(self, "neighborhood")
 
 
+MAX_WEIGHT = 1e6
+MAX_T_PRED_S = 10.0
+
+
 @dataclass(frozen=True)
 class ControlSettings:
     """MPC and control-cycle parameters (paper 4.2, Table 2 as MODEL.md fills it)."""
@@ -282,6 +239,11 @@ class ControlSettings:
         _positive(self, "t_pred_s", "t_cont_s", "s_max_work_m_s", "s_max_support_m_s")
         _positive(self, "arrival_tol_m", "support_max_sigma0_m")
         _non_negative(self, "w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")
+        weights = ("w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")
+        _at_most(self, MAX_WEIGHT, "beyond, the MPC's cost is ill-conditioned", *weights)
+        _at_most(self, MAX_T_PRED_S, "a prediction step of at most 10 s", "t_pred_s")
+        for name in ("s_max_work_m_s", "s_max_support_m_s"):
+            _as_parameter(name, 100 * getattr(self, name), "WPNAV_SPEED", " cm/s")
 
     @property
     def d_max_work_m(self) -> float:

@@ -34,5 +34,10 @@ class WindSettings:
             _require(refusal is None, name, f"{refusal} (the vehicles' {parameter})")
         _require(0 <= self.from_deg < 360, "from_deg", "must be in [0, 360)")
         _require(0 <= self.shelter <= 1, "shelter", "must be in [0, 1]")
-        _require(self.edge_gain >= 1, "edge_gain", "must be at least 1")
+        _require(
+            1 <= self.edge_gain <= 2,
+            "edge_gain",
+            "must be in [1, 2] (potential flow past a cylinder is twice as fast at its sides, "
+            "the most a bluff body speeds a flow up)",
+        )
         _positive(self, "edge_width_m")

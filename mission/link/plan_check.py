@@ -95,13 +95,26 @@ def _check_row(world: KnownWorld, frame: GeodeticFrame, path: Path, row: Waypoin
         raise InputError(str(path), where, f"{shown} (ENU) lies {problem}")
 
 
+def check_work_waypoints_clear(world: KnownWorld) -> None:
+    """The work UAV's path where it can be flown: each waypoint outside the structure and at
+    least ``control.clearance_m`` from it (a waypoint file written by hand, not planned)."""
+    scenario = world.scenario
+    for i, point in enumerate(scenario.task.work_waypoints_m):
+        place = np.asarray(point, dtype=float)
+        problem = world.placement_problem(place) or world.clearance_problem(place)
+        if problem is not None:
+            field = f"task.work_waypoints_m[{i}]"
+            raise InputError(scenario.source, field, f"{list(point)} lies {problem}")
+
+
 def check_inspections_placed(world: KnownWorld) -> None:
     """Every support's own inspection waypoint where a vehicle can be (outside the
     structure): the first that is not raises InputError naming the scenario file and field."""
     scenario = world.scenario
     for i, inspection in enumerate(scenario.task.inspections):
         for j, point in enumerate(inspection.waypoints_m):
-            problem = world.placement_problem(np.asarray(point, dtype=float))
+            place = np.asarray(point, dtype=float)
+            problem = world.placement_problem(place) or world.clearance_problem(place)
             if problem is not None:
                 field = f"task.inspections[{i}].waypoints_m[{j}]"
                 raise InputError(scenario.source, field, f"{list(point)} lies {problem}")

@@ -73,6 +73,14 @@ def _check_work_waypoints(world: KnownWorld, work: np.ndarray) -> None:
             f"task.work_waypoints_m[{i}]",
             f"work waypoint {i + 1} {work[i].tolist()} lies inside the structure",
         )
+    for i, point in enumerate(work):
+        problem = world.clearance_problem(point)
+        if problem is not None:
+            raise PlanningError(
+                world.scenario.source,
+                f"task.work_waypoints_m[{i}]",
+                f"work waypoint {i + 1} {point.tolist()} lies {problem}",
+            )
 
 
 def _admissible_points(world: KnownWorld) -> tuple[np.ndarray, np.ndarray]:

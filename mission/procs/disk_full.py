@@ -1,16 +1,18 @@
-"""A full disk (or an exhausted quota): said on one line naming the file, exit status
-:data:`EXIT_NO_SPACE`, and what the command had begun to write removed, so no half output is
-left for a later command to mistake for a whole one."""
+"""A full disk (or an exhausted quota, a read-only file system, a file over the size limit):
+said on one line naming the file, exit status :data:`EXIT_NO_SPACE`, and what the command had
+begun to write removed, so no half output is left for a later command to mistake for a whole one."""
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import os
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
-NO_SPACE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT})
+# and what fails a write alike: a read-only file system, a file over the size limit (ulimit -f)
+NO_SPACE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG})
 EXIT_NO_SPACE = 3
 
 
@@ -28,7 +30,8 @@ def no_space_error(error: BaseException | None) -> OSError | None:
 
 def no_space_line(error: OSError, fallback: str = "an output file") -> str:
     """The one line that says so."""
-    return f"error: {error.filename or fallback}: no space left on device"
+    said = os.strerror(error.errno).lower() if error.errno else "no space left on device"
+    return f"error: {error.filename or fallback}: {said}"
 
 
 @contextlib.contextmanager

@@ -32,6 +32,8 @@ def check_output_file(path: Path, flag: str, suffixes: tuple[str, ...] = ()) -> 
         raise InputError("command line", flag, f"{str(path)!r}: the file name must end in {wanted}")
     if path.is_dir():
         raise InputError("command line", flag, f"{str(path)!r} is a directory, not a file")
+    if path.is_symlink() and not path.exists():
+        raise InputError("command line", flag, f"{str(path)!r} is a link to a missing file")
     parent = path.parent
     if not parent.is_dir():
         raise InputError("command line", flag, f"{str(path)!r}: no directory {str(parent)!r}")

@@ -58,6 +58,8 @@ MAX_RUNS = 1_000_000
 # a minute, and a study of more than ANNOUNCED_POINTS says so before it checks them.
 MAX_POINTS = 10_000
 ANNOUNCED_POINTS = 200
+ANNOUNCED_RUNS = 10_000  # planning a run's key takes ~20 us: 10^6 take ~20 s
+ANNOUNCED_BYTES = 1_000_000  # a study file this long takes seconds to read
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,6 +167,9 @@ def load_study(path: Path, say: Callable[[str], None] | None = None) -> StudySpe
     """Read and validate a study file (every scenario at every point included); ``say`` is
     told, before a long check of the points starts, how many there are."""
     source = str(path)
+    size = path.stat().st_size if path.is_file() else 0
+    if say is not None and size > ANNOUNCED_BYTES:
+        say(f"reading {source} ({size / 1e6:.1f} MB)")
     data = read_yaml_mapping(path) if path.is_file() else _missing(path)
     unknown = sorted(set(map(str, data)) - _KEYS)
     if unknown:
@@ -205,6 +210,8 @@ def load_study(path: Path, say: Callable[[str], None] | None = None) -> StudySpe
         raise InputError(source, "tables", "Table 3 is for a study of one point (no grid)")
     if spec.size > MAX_RUNS:
         raise InputError(source, "", f"{spec.size} runs; at most {MAX_RUNS} in one study")
+    if say is not None and spec.size > ANNOUNCED_RUNS:
+        say(f"{spec.size:,} runs: checking and planning them takes a while")
     checked = len(spec.points) * len(spec.scenarios)
     if say is not None and checked > ANNOUNCED_POINTS:
         say(f"checking the scenario of each of {checked:,} points (a few ms each)")

@@ -10,16 +10,19 @@ from pathlib import Path
 import numpy as np
 
 from mission.analysis.metrics import scan_records
-from mission.analysis.records_file import read_records_file
+from mission.analysis.records_file import RunShape, read_records_file
 from mission.config.errors import InputError
 from mission.viewer.tail import SNAPSHOT_NAME, VIEWED_IDS
 
 
-def check_run_files(run_dir: Path, map_shape: tuple[int, ...], recorded: dict) -> list[str]:
-    """Raise InputError for a file of ``run_dir`` that is not a run's; return warnings for
-    files cut short (``recorded``: the run's summary.json, or {})."""
+def check_run_files(
+    run_dir: Path, map_shape: tuple[int, ...], recorded: dict, shape: RunShape | None = None
+) -> list[str]:
+    """Raise InputError for a file of ``run_dir`` that is not a run's (its records of a run
+    of ``shape``, if given); return warnings for files cut short (``recorded``: the run's
+    summary.json, or {})."""
     warnings = _check_tlog(run_dir / "gcs.tlog")
-    cycles, cut = _check_records(run_dir / "records.jsonl")
+    cycles, cut = _check_records(run_dir / "records.jsonl", shape)
     if cut:
         warnings.append(f"{run_dir / 'records.jsonl'}: its last line is cut: the view ends before")
     expected = recorded.get("control_cycles")
@@ -44,9 +47,11 @@ def _check_tlog(path: Path) -> list[str]:
     return []
 
 
-def _check_records(path: Path) -> tuple[int, bool]:
+def _check_records(path: Path, shape: RunShape | None) -> tuple[int, bool]:
     """(whole cycle records, whether the last line is cut)."""
-    found = read_records_file(path)
+    if (path.exists() or path.is_symlink()) and not path.is_file():
+        raise InputError(str(path), "", "is not a regular file")
+    found = read_records_file(path, shape)
     if not found.records:
         raise InputError(str(path), "", "holds no control cycle's record")
     return len(found.records), found.cut

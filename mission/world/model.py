@@ -24,6 +24,8 @@ from mission.world.sky import load_sky
 from mission.world.structure import Structure, build_structure
 from mission.world.zones import MultipathZones
 
+CLEARANCE_TOLERANCE_M = 1e-6  # a waypoint exactly at the margin is on it
+
 
 @dataclass(frozen=True)
 class Sigma0Map:
@@ -72,6 +74,20 @@ class KnownWorld:
             return "outside the workspace"
         if self.structure.contains(point)[0]:
             return "inside the structure"
+        return None
+
+    def clearance_problem(self, point: np.ndarray) -> str | None:
+        """Why a scenario's waypoint is too close to the structure to be flown to: within
+        ``control.clearance_m``, the margin the MPCs keep from it (None: it is not)."""
+        from mission.world.proximity import StructureProximity
+
+        margin = self.scenario.control.clearance_m
+        distance = float(StructureProximity(self.structure).distance(point)[0])
+        if distance < margin - CLEARANCE_TOLERANCE_M:
+            return (
+                f"{distance:.2f} m from the structure, closer than control.clearance_m "
+                f"({margin:g} m), the margin the MPCs keep: it could never be reached"
+            )
         return None
 
     def map_grid(self) -> VoxelGrid:

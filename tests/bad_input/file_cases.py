@@ -185,6 +185,16 @@ FILE_CASES = [
                 "autopilot.position_gain_per_s",
                 "below velocity_gain_per_s",
             ),
+            (
+                "cascade-too-close",  # each loop faster than the one outside it, and unstable
+                FLOWN
+                % (
+                    "autopilot: {position_gain_per_s: 15, velocity_gain_per_s: 30, "
+                    "attitude_gain_per_s: 60, rate_gain_per_s: 99}"
+                ),
+                "autopilot.position_gain_per_s",
+                "by a factor of at least 2.5",
+            ),
             ("wind-45", "world: {wind: {speed_m_s: 45}}\n", "wind.speed_m_s", "[0, 40]"),
             ("wind-1e6", "world: {wind: {speed_m_s: 1.0e+6}}\n", "wind.speed_m_s", "[0, 40]"),
             ("turbulence", "world: {wind: {turbulence: 1.0e+6}}\n", "wind.turbulence", "[0, 10]"),
@@ -219,7 +229,7 @@ FILE_CASES = [
     (
         "run-plan-breaks-clearance",
         lambda t: [*RUN, str(scenario_file(t, "control: {clearance_m: 1.5}\n"))],
-        ["work.waypoints", "item", "control.clearance_m (1.5 m)"],
+        ["task.work_waypoints_m[0]", "control.clearance_m (1.5 m)"],
     ),
     # --- scripted faults ---------------------------------------------------------------
     _fault_case(

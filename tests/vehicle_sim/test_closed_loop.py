@@ -95,7 +95,7 @@ def test_the_same_flight_twice_is_the_same_bit_for_bit(loop):
 
 
 def test_a_tilt_limit_of_90_degrees_or_more_is_refused():
-    with pytest.raises(FieldProblem, match="less than 90"):
+    with pytest.raises(FieldProblem, match=r"\[5, 90\) degrees"):
         replace(LOOPS, tilt_max_deg=90.0)
 
 
