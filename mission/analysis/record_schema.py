@@ -94,8 +94,13 @@ def _object(required: dict[str, Check], optional: dict[str, Check] | None = None
     return checked
 
 
-_SOLVE = _object(
-    {"status": _text, "ms": _number, "path": _list_of(_point)}, {"resolved": _optional(_flag)}
+def _non_empty(check: Check) -> Check:
+    return lambda value: "expected at least one item" if value == [] else check(value)
+
+
+_SOLVE = _object(  # an MPC's path holds its horizon's points: never none (horizon_steps >= 1)
+    {"status": _text, "ms": _number, "path": _non_empty(_list_of(_point))},
+    {"resolved": _optional(_flag)},
 )
 _INTEGRITY = _object(
     {

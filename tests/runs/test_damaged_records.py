@@ -49,6 +49,23 @@ DAMAGE = {
     "time-1e300": (_replace_field("t", 1e300), "t: expected a time"),
     "xhat-a-string": (_replace_field("xhat", "here"), "xhat: expected 3 finite numbers"),
     "roles-a-number": (_replace_field("roles", 5), "roles: expected an object"),
+    # of another run, or edited (issue 46's red team)
+    "nested-deep": (_foreign(b"[" * 200_000 + b"]" * 200_000), "nested too deeply"),
+    "a-support-not-flown": (
+        _replace_field("consistent", ["support-9"]),
+        "'support-9' is no support",
+    ),
+    "a-role-never-given": (_replace_field("roles", {"roles": {"support-1": "pilot"}}), "'pilot'"),
+    "a-waypoint-not-flown": (_replace_field("arrived", 999), "arrived: waypoint 999"),
+    "off-the-grid": (_replace_field("t", 1.75), "off the control period's grid"),
+    "a-line-deleted": (
+        lambda data: b"".join(_lines(data)[:3] + _lines(data)[4:]),
+        "a line deleted?",
+    ),
+    "an-empty-mpc-path": (
+        _replace_field("mpc", {"support-1": {"status": "x", "ms": 1.0, "path": []}}),
+        "expected at least one item",
+    ),
 }
 
 
