@@ -54,10 +54,16 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
     positions = {v: (v if numeric else i) for i, v in enumerate(values)}
     varying = _varying_keys(spec)
+    names = ["default" if v is None else str(v) for v in values]
+    # many long names (a scenario's faults) do not fit under a tick: letters there, the names
+    # listed under the panels
+    lettered = not numeric and len(names) > 4 and max(map(len, names)) > 24
+    key_lines = [f"{chr(65 + i)}: {n}" for i, n in enumerate(names)] if lettered else []
+    key_height = 0.16 * len(key_lines) + (0.2 if key_lines else 0.0)
     figure, axes = plt.subplots(
         len(metrics),
         len(scenarios),
-        figsize=(4.2 * len(scenarios), 2.6 * len(metrics)),
+        figsize=(4.2 * len(scenarios), 2.6 * len(metrics) + key_height),
         squeeze=False,
     )
     for column_index, scenario in enumerate(scenarios):
@@ -81,8 +87,9 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
                 if xs:
                     name = method.upper() + (f", {rest}" if rest else "")
                     axis.errorbar(xs, ys, yerr=errors, marker="o", capsize=3, label=name)
-            if not numeric:  # a point that does not set the key flies the scenario's default
-                names = ["default" if v is None else str(v) for v in values]
+            if lettered:
+                axis.set_xticks(range(len(values)), [chr(65 + i) for i in range(len(values))])
+            elif not numeric:  # a point that does not set the key flies the scenario's default
                 axis.set_xticks(range(len(values)), [textwrap.fill(n, 12) for n in names])
                 axis.tick_params(axis="x", labelsize=6)
             axis.set_xlabel(key)
@@ -105,7 +112,9 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
         frameon=False,
     )
     top = 1 - (0.55 + 0.2 * legend_rows) / height
-    figure.tight_layout(rect=(0, 0, 1, top))
+    if key_lines:
+        figure.text(0.02, 0.1 / height, "\n".join(key_lines), fontsize=7, va="bottom")
+    figure.tight_layout(rect=(0, key_height / height, 1, top))
     save_figure(figure, path)
 
 

@@ -55,3 +55,18 @@ def test_a_point_that_does_not_set_the_key_sits_at_default(tmp_path, drawn):
     _study(tmp_path, points)
     axis = drawn["metrics-vs-control.escape_starts.png"].axes[0]
     assert [tick.get_text() for tick in axis.get_xticklabels()] == ["default", "False"]
+
+
+def test_many_long_point_names_are_letters_under_the_ticks_and_listed_below(tmp_path, drawn):
+    faults = [
+        [{"at_s": 10, "vehicle": "support-1", "param": "SIM_GPS1_GLTCH_Z", "value": float(size),
+          "duration_s": 30}]
+        for size in (1, 2, 3, 4, 5)
+    ]  # fmt: skip
+    _study(tmp_path, tuple(Point((("faults", f),)) for f in faults))
+    figure = drawn["metrics-vs-faults.png"]
+    ticks = [tick.get_text() for tick in figure.axes[0].get_xticklabels()]
+    assert ticks == ["A", "B", "C", "D", "E"]
+    listed = "\n".join(text.get_text() for text in figure.texts)
+    for letter, size in zip("ABCDE", (1, 2, 3, 4, 5), strict=True):
+        assert f"{letter}: support-1 SIM_GPS1_GLTCH_Z={size:g}" in listed
