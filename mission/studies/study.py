@@ -91,12 +91,13 @@ def run_study(
     pending = [run for run in canaries + runs if run not in summaries]
     failed: list[str] = []
     already = sum(1 for run in runs if run in summaries)
+    outputs = StudyOutputs(out_dir, spec, runs, canaries, code)
+    outputs.write(summaries, 0, report=False)  # first: a disk that cannot hold it says so alone
     bar = ProgressBar(len(runs), already, progress, engine.description)
     note = duration_note(len(pending), engine.cores)
     if note:
         progress.write(note + "\n")
     start = last_report = time.monotonic()
-    outputs = StudyOutputs(out_dir, spec, runs, canaries, code)
 
     def done(run: StudyRun, summary: dict | None, wall: float) -> None:
         nonlocal last_report
