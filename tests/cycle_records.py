@@ -21,7 +21,9 @@ def cycle_record(t: float, **fields: Any) -> dict[str, Any]:
         "beta": {"support-1": 0.5},
         "arrived": None,
         "g_updated_voxels": 1,
-        "mpc": {"support-1": {"status": "ok", "ms": 1.0, "resolved": False, "path": []}},
+        "mpc": {
+            "support-1": {"status": "ok", "ms": 1.0, "resolved": False, "path": [[0.0, 0.0, 7.0]]}
+        },
         "cycle_ms": 2.0,
     }
     record.update(fields)

@@ -97,11 +97,18 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
             axis.grid(alpha=0.3)
             if row_index == 0:
                 axis.set_title(scenario)
+    title = f"{spec.name}: each metric against {key} (mean, 95 % CI)"
+    _frame(figure, axes, title, key_lines, key_height)
+    save_figure(figure, path)
+
+
+def _frame(figure, axes, title: str, key_lines: list[str], key_height: float) -> None:
+    """The title on top, the legend in two columns under it, the panels below both, and the
+    names of lettered points (if any) under the panels."""
     handles, labels = axes[0][0].get_legend_handles_labels()
-    # the title on top, the legend in two columns under it, the panels below both
     height = figure.get_figheight()
     legend_rows = -(-len(labels) // 2)
-    figure.suptitle(f"{spec.name}: each metric against {key} (mean, 95 % CI)", y=1 - 0.12 / height)
+    figure.suptitle(title, y=1 - 0.12 / height)
     figure.legend(
         handles,
         labels,
@@ -115,7 +122,6 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     if key_lines:
         figure.text(0.02, 0.1 / height, "\n".join(key_lines), fontsize=7, va="bottom")
     figure.tight_layout(rect=(0, key_height / height, 1, top))
-    save_figure(figure, path)
 
 
 def _value(point: Point, key: str) -> object:
