@@ -12,7 +12,8 @@ point costs
 subject to a minimum separation between supports and reachability at the support speed in the
 time the work UAV needs between waypoints. Each support's path is found by dynamic programming
 over i with the others held fixed; a few rounds of this coordinate descent settle the formation.
-Everything is deterministic (stable sorts, first-index tie breaks).
+Everything is deterministic (stable sorts, first-index tie breaks, costs settled to 1e-12 so
+that a tie stays a tie whatever the last bits of numpy's kernels).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from mission.world.grid import VoxelGrid
 from mission.world.model import KnownWorld
 
 CANDIDATES_PER_INDEX = 1000
+COST_DECIMALS = 12  # a plan cost's resolution, of costs of order 1-100 (their last bits ~1e-14)
 
 
 class PlanningError(InputError):
@@ -120,6 +122,7 @@ def _candidates_for(
         )
     relative = np.trace(world.camera.covariance(waypoint - points[visible]), axis1=1, axis2=2)
     cost = settings.w_gnss_per_m2 * sigma0_sq[visible] + settings.w_relative_per_m2 * relative
+    cost = _settled(cost)
     best = np.argsort(cost, kind="stable")[:CANDIDATES_PER_INDEX]
     return _Candidates(points[visible][best], cost[best])
 
@@ -143,7 +146,7 @@ def _plan_one(
         transition = total[None, :] + settings.w_move_per_m * step
         transition[step > reach[i - 1]] = np.inf
         transition[~legs_clear[i - 1]] = np.inf
-        choice = np.argmin(transition, axis=1)
+        choice = np.argmin(_settled(transition), axis=1)
         total = transition[np.arange(len(current)), choice] + _stage_cost(
             settings, work[i], candidates[i], candidates, others, i
         )
@@ -156,10 +159,16 @@ def _plan_one(
                 f"{i + 1} in time (or keep its separation)",
             )
     path = np.empty(len(work), dtype=int)
-    path[-1] = int(np.argmin(total))
+    path[-1] = int(np.argmin(_settled(total)))
     for i in range(len(work) - 1, 0, -1):
         path[i - 1] = back[i - 1][path[i]]
     return path
+
+
+def _settled(cost: np.ndarray) -> np.ndarray:
+    """Costs rounded to COST_DECIMALS: candidates a lattice's symmetry makes equal stay
+    equal whatever the last bits of numpy's kernels (AVX2 or SSE), and the first index wins."""
+    return np.round(cost, COST_DECIMALS)
 
 
 def _legs_clear(world: KnownWorld, previous: np.ndarray, current: np.ndarray) -> np.ndarray:
