@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from mission.config.checks import as_parameter as _as_parameter
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
-from mission.config.vehicle_parameters import parameter_spec
 
 
 @dataclass(frozen=True)
@@ -27,11 +27,8 @@ class WindSettings:
 
     def __post_init__(self) -> None:
         _non_negative(self, "speed_m_s", "turbulence")
-        for name, parameter in (("speed_m_s", "SIM_WIND_SPD"), ("turbulence", "SIM_WIND_DRYDEN")):
-            spec = parameter_spec(parameter)  # the vehicle's parameter the setting seeds
-            assert spec is not None
-            refusal = spec.refusal(getattr(self, name))
-            _require(refusal is None, name, f"{refusal} (the vehicles' {parameter})")
+        _as_parameter("speed_m_s", self.speed_m_s, "SIM_WIND_SPD")
+        _as_parameter("turbulence", self.turbulence, "SIM_WIND_DRYDEN")
         _require(0 <= self.from_deg < 360, "from_deg", "must be in [0, 360)")
         _require(0 <= self.shelter <= 1, "shelter", "must be in [0, 1]")
         _require(

@@ -3,6 +3,8 @@ and signing keys (id, argv builder, texts the one error line must hold)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from tests.bad_input.builders import (
     RUN,
     SHIPPED_PLAN,
@@ -16,6 +18,8 @@ from tests.bad_input.builders import (
     study_file,
     tlog_run,
 )
+
+SUMMARY_ALONG = '{"scenario": "along"}'
 
 COMMAND_CASES = [
     # --- command-line arguments --------------------------------------------------------
@@ -132,6 +136,26 @@ COMMAND_CASES = [
         lambda t: ["analyze", str(tlog_run(t, b"x", summary="[1, 2]"))],
         ["summary.json", "not a JSON object"],
     ),
+    (
+        "analyze-another-flight",  # --scenario may judge a run otherwise, not fly it otherwise
+        lambda t: [
+            "analyze",
+            str(tlog_run(t, b"x", summary=SUMMARY_ALONG)),
+            "--scenario",
+            "twozone-4",
+        ],
+        ["--scenario", "task.supports", "the run did not fly it"],
+    ),
+    (
+        "analyze-records-a-folder",
+        lambda t: ["analyze", str(_with_records_folder(tlog_run(t, b"x", summary=SUMMARY_ALONG)))],
+        ["records.jsonl", "not a regular file"],
+    ),
+    (
+        "plot-onto-a-dangling-link",
+        lambda t: ["world", "along", "--plot", str(_dangling_link(t, "w.png"))],
+        ["--plot", "a link to a missing file"],
+    ),
     # --- mission study -------------------------------------------------------------------
     ("study-missing", lambda t: ["study", str(t / "none.yaml")], ["none.yaml", "no such study"]),
     (
@@ -216,6 +240,11 @@ COMMAND_CASES = [
         ["--against", "is for --verify"],
     ),
     (
+        "study-draw-seed-alone",
+        lambda t: ["study", str(study_file(t)), "--draw-seed", "3"],
+        ["--draw-seed", "is for --verify N"],
+    ),
+    (
         "study-historical-alone",
         lambda t: ["study", str(study_file(t)), "--historical", "old code"],
         ["--historical", "--report-only"],
@@ -282,3 +311,14 @@ COMMAND_CASES = [
         ["link.key"],
     ),
 ]
+
+
+def _with_records_folder(run: Path) -> Path:
+    (run / "records.jsonl").mkdir()
+    return run
+
+
+def _dangling_link(tmp: Path, name: str) -> Path:
+    link = tmp / name
+    link.symlink_to(tmp / "gone" / name)
+    return link

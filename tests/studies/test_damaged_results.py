@@ -52,6 +52,15 @@ DAMAGE = {
     "empty": (lambda d: b"", "is empty"),
     "unknown-point": (_cell("point", "7"), "point 7"),
     "a-row-twice": (lambda d: d + d.split(b"\n", 2)[1] + b"\n", "a second time"),
+    # issue 46's red team
+    "a-nul-byte": (_cell("run_key", "ab\0cd"), "line 3: holds a NUL byte"),
+    "a-column-twice": (
+        lambda d: d.replace(b"completion_time_s", b"control_cycles", 1),
+        "the column control_cycles is named twice",
+    ),
+    "a-huge-time": (_cell("completion_time_s", "1.7e308"), "is no run's"),
+    "a-completed-run-without-time": (_cell("completion_time_s", ""), "completion time is missing"),
+    "a-cell-of-1-mb": (_cell("run_key", '"' + "x" * 1_000_000 + '"'), "is not CSV a study writes"),
 }
 
 
@@ -70,3 +79,16 @@ def test_a_damaged_results_file_is_refused_and_nothing_rewritten(tmp_path, capsy
     assert status == 2, err
     assert len(lines) == 1 and "results.csv" in lines[0] and expected in lines[0], lines
     assert {p: p.read_bytes() for p in sorted(study.rglob("*")) if p.is_file()} == before
+
+
+def test_rows_in_another_order_give_the_same_report(tmp_path):
+    spec = str(ROOT / "studies" / "table3.yaml")
+    made = {}
+    for name, order in (("as-made", lambda rows: rows), ("reversed", lambda rows: rows[::-1])):
+        study = tmp_path / name
+        shutil.copytree(STUDY, study)
+        header, *rows = (study / "results.csv").read_text().splitlines(keepends=True)
+        (study / "results.csv").write_text(header + "".join(order(rows)))
+        assert mission_cli.entry_point(["study", spec, "--out", str(study), "--report-only"]) == 0
+        made[name] = (study / "report.md").read_bytes(), (study / "table.md").read_bytes()
+    assert made["as-made"] == made["reversed"]
