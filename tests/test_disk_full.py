@@ -48,12 +48,12 @@ def _files(disk: Path) -> set[str]:
     return {str(p.relative_to(disk)) for p in disk.rglob("*")}
 
 
-def _refused(disk: Path, *argv: str) -> str:
+def _refused(disk: Path, *argv: str, said: str = "no space left on device") -> str:
     before = _files(disk)
     result = mission(*argv)
     lines = result.stderr.strip().splitlines()
     assert result.returncode == EXIT_NO_SPACE, result.stderr
-    assert lines and lines[-1].endswith(": no space left on device"), lines
+    assert lines and lines[-1].endswith(f": {said}"), lines
     assert "Traceback" not in result.stderr
     assert _files(disk) == before, "what it began to write is left"
     return lines[-1]
@@ -79,6 +79,24 @@ def test_a_plan_on_a_full_disk(small_disk):
     _fill(small_disk, 6_000)  # room for a waypoint file or two, not four
     line = _refused(small_disk, "plan", "along", "--out", str(small_disk / "plan"))
     assert str(small_disk / "plan") in line
+
+
+def test_a_plan_and_its_figure_or_neither(small_disk, tmp_path):
+    _fill(small_disk, 4_000)  # the plan goes elsewhere, its figure onto the full disk
+    plan = tmp_path / "plan"
+    line = _refused(
+        small_disk, "plan", "along", "--out", str(plan), "--plot", str(small_disk / "p.png")
+    )
+    assert "p.png" in line
+    assert not plan.exists(), "the plan was left without its figure"
+
+
+def test_a_read_only_file_system_is_said_as_a_full_disk_is(small_disk, short_run):
+    run = small_disk / "run"
+    shutil.copytree(short_run[0], run, ignore=shutil.ignore_patterns("plots", "g"))
+    subprocess.run(["mount", "-o", "remount,ro", str(small_disk)], check=True)
+    line = _refused(small_disk, "analyze", str(run), said="read-only file system")
+    assert str(run / "summary.json") in line
 
 
 def test_a_recording_and_figures_on_a_full_disk(small_disk, short_run):

@@ -15,7 +15,12 @@ from mission.procs.disk_full import NO_SPACE_ERRNOS
 def write_atomically(path: Path, write: Callable[[str], None]) -> None:
     """Call ``write(temp_path)`` then move the result over ``path`` in one rename."""
     path = Path(path)
-    handle, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
+    try:
+        handle, temp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
+    except OSError as error:  # a read-only or full file system: name the file meant
+        if error.errno in NO_SPACE_ERRNOS:
+            raise OSError(error.errno, os.strerror(error.errno), str(path)) from error
+        raise
     os.close(handle)
     try:
         write(temp)

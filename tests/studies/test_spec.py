@@ -200,3 +200,18 @@ def test_a_study_of_many_points_says_so_before_it_checks_them(tmp_path):
     spec = load_study(path, say=said.append)
     assert len(spec.points) == 225
     assert said == ["checking the scenario of each of 225 points (a few ms each)"]
+
+
+def test_a_study_of_many_runs_or_a_long_file_says_so_before_the_slow_part(tmp_path):
+    many = tmp_path / "many.yaml"
+    many.write_text("scenarios: [along]\nmethods: [ac]\nseeds: 20000\n")
+    said: list[str] = []
+    load_study(many, say=said.append)
+    assert said == ["20,000 runs: checking and planning them takes a while"]
+    long = tmp_path / "long.yaml"
+    long.write_text(
+        "scenarios: [along]\nmethods: [ac]\nseeds: [" + ", ".join(map(str, range(200_000))) + "]\n"
+    )
+    said.clear()
+    load_study(long, say=said.append)
+    assert said[0].startswith(f"reading {long} (1.") and said[0].endswith(" MB)")
