@@ -1,13 +1,14 @@
 """A vehicle's GNSS receiver: the world's fix under the receiver's live parameters, then its
 failures.
 
-In order: the fix at the truth with the multipath zones' bias times ``SIM_MP_SCALE`` and noise
-of ``SIM_GPS_UERE`` (the accuracy fields say the same sigma); the glitch
-``SIM_GPS1_GLTCH_X/Y/Z`` added (degrees of latitude and longitude and metres of altitude, as
-ArduPilot's SITL adds its glitch); the fix of ``SIM_GPS1_LAG_MS`` earlier (whole samples),
-stamped now, as a receiver that does not know its latency sends it (the failure DELAYED, by
-contrast, keeps the old stamp); then an injected failure (:mod:`~vehicle_sim.failures`). At the
-defaults (scale 1, no glitch, no lag) the fix is the world's, draw for draw.
+In order: the fix at the truth with the world's multipath (the zones' bias, the structure's
+reflections, or both) times ``SIM_MP_SCALE`` and noise of ``SIM_GPS_UERE`` (the accuracy
+fields say the same sigma); the glitch ``SIM_GPS1_GLTCH_X/Y/Z`` added (degrees of latitude
+and longitude and metres of altitude, as ArduPilot's SITL adds its glitch); the fix of
+``SIM_GPS1_LAG_MS`` earlier (whole samples), stamped now, as a receiver that does not know
+its latency sends it (the failure DELAYED, by contrast, keeps the old stamp); then an
+injected failure (:mod:`~vehicle_sim.failures`). At the defaults (scale 1, no glitch, no
+lag) the fix is the world's, draw for draw.
 """
 
 from __future__ import annotations
@@ -49,12 +50,8 @@ class GnssReceiver:
     def reading(self, truth: np.ndarray, time_usec: int) -> Any | None:
         """GPS_RAW_INT at ``truth`` for ``time_usec`` (None: the receiver publishes nothing)."""
         value = self._parameters.value
-        offset = self._world.zone_offset(truth[None])[0]
-        scale = value("SIM_MP_SCALE")
-        if scale != 1.0:
-            offset = scale * offset
         sigma = value("SIM_GPS_UERE")
-        fix = self._world.gnss.sample_fix(truth, self._rng, offset, sigma_uere_m=sigma)
+        fix = self._world.gnss_fix(truth, self._rng, sigma, value("SIM_MP_SCALE"))
         message = _glitched(
             telemetry.gps_raw_int(fix, self._frame, time_usec, sigma),
             value("SIM_GPS1_GLTCH_X"),

@@ -71,10 +71,18 @@ def sys_status(bad_packets: int) -> mavlink2.MAVLink_sys_status_message:
     )
 
 
+_FIX_TYPE = {  # a receiver's solution as GPS_RAW_INT's fix_type
+    "rtk-fixed": mavlink2.GPS_FIX_TYPE_RTK_FIXED,
+    "rtk-float": mavlink2.GPS_FIX_TYPE_RTK_FLOAT,
+    "code": mavlink2.GPS_FIX_TYPE_DGPS,
+}
+
+
 def gps_raw_int(
     fix: GnssFix, frame: GeodeticFrame, time_usec: int, sigma_uere_m: float
 ) -> mavlink2.MAVLink_gps_raw_int_message:
-    """GPS_RAW_INT from a receiver fix; accuracy fields from the geometry alone."""
+    """GPS_RAW_INT from a receiver fix: the satellites it used, its solution's fix type, and
+    accuracy fields from the geometry it used (never its bias)."""
     if not fix.has_fix or fix.position_m is None:
         return mavlink2.MAVLink_gps_raw_int_message(
             time_usec,
@@ -98,7 +106,7 @@ def gps_raw_int(
     hdop, vdop = float(fix.hdop or 0.0), float(fix.vdop or 0.0)
     return mavlink2.MAVLink_gps_raw_int_message(
         time_usec,
-        mavlink2.GPS_FIX_TYPE_RTK_FIXED,
+        _FIX_TYPE[fix.solution],
         lat_e7,
         lon_e7,
         round(alt_m * 1000),

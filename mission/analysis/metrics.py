@@ -40,12 +40,14 @@ from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import World
 
 GCS_SYSTEM_ID = 255
+MIN_3D_FIX = 3
 _LINK_EVENT = re.compile(r"^support-\d+ (lost|back)")
 _CONTACT = re.compile(r"^(Crash|Contact): (\S+) t=(-?[\d.]+) at (-?[\d.]+),(-?[\d.]+),(-?[\d.]+)")
 _WANTED_IDS = frozenset(
     {
         mavlink2.MAVLINK_MSG_ID_SIM_STATE,
         mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED,
+        mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT,
         mavlink2.MAVLINK_MSG_ID_VISION_POSITION_ESTIMATE,
         mavlink2.MAVLINK_MSG_ID_SET_POSITION_TARGET_LOCAL_NED,
         mavlink2.MAVLINK_MSG_ID_SYSTEM_TIME,
@@ -98,6 +100,10 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
             truth = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
             samples.pending[TRUTH][source] = truth
+        elif kind == "GPS_RAW_INT" and source != GCS_SYSTEM_ID:
+            if message.fix_type >= MIN_3D_FIX:
+                fix = frame.from_degE7(message.lat, message.lon, message.alt / 1000.0)
+                samples.pending[FIX][source] = fix
         elif kind == "LOCAL_POSITION_NED" and source != GCS_SYSTEM_ID:
             belief = ned_to_enu(np.array([message.x, message.y, message.z]))
             samples.pending[BELIEF][source] = belief
@@ -130,7 +136,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
                 _station_said(trace, text, t)
     offsets = {} if trace.ticks else clock_offsets(replies)
     epoch_usec = round(epoch * 1e6)
-    for kind, into in ((TRUTH, trace.truth), (BELIEF, trace.beliefs)):
+    for kind, into in ((TRUTH, trace.truth), (BELIEF, trace.beliefs), (FIX, trace.fixes)):
         for system, stamp, position in samples.stamped[kind]:
             if trace.ticks or system in offsets:
                 into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
@@ -164,16 +170,21 @@ def _station_said(trace: RunTrace, text: str, t: float) -> None:
         trace.link_events.append({"t": t, "event": text})
 
 
-TRUTH, BELIEF = "truth", "belief"
+TRUTH, BELIEF, FIX = "truth", "belief", "fix"
 
 
 class _StepSamples:
-    """Each vehicle's truth (SIM_STATE) and belief (LOCAL_POSITION_NED) of a step, held until
+    """Each vehicle's truth (SIM_STATE), belief (LOCAL_POSITION_NED) and GNSS fix (a 3-D
+    GPS_RAW_INT) of a step, held until
     that step's SYSTEM_TIME marker stamps them: (system, stamp in usec, position)."""
 
     def __init__(self) -> None:
-        self.pending: dict[str, dict[int, np.ndarray]] = {TRUTH: {}, BELIEF: {}}
-        self.stamped: dict[str, list[tuple[int, int, np.ndarray]]] = {TRUTH: [], BELIEF: []}
+        self.pending: dict[str, dict[int, np.ndarray]] = {TRUTH: {}, BELIEF: {}, FIX: {}}
+        self.stamped: dict[str, list[tuple[int, int, np.ndarray]]] = {
+            TRUTH: [],
+            BELIEF: [],
+            FIX: [],
+        }
 
     def stamp(self, system: int, usec: int) -> None:
         """The step's marker: what ``system`` sent before it is stamped with ``usec``."""
@@ -273,6 +284,19 @@ def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
     return np.array(times)[known], errors
 
 
+def support_gnss_errors(trace: RunTrace) -> dict[str, dict[str, float | None]]:
+    """Per support, |fix - truth| of every 3-D fix it reported (mean, p95, max): its
+    receiver's true error, whatever made it (zones, reflections, noise, faults)."""
+    errors = {}
+    for system in trace.supports:
+        times = sorted(t for s, t in trace.fixes if s == system)
+        truth, known = trace.truth_at(system, times)
+        fixes = np.array([trace.fixes[(system, t)] for t in times]).reshape(-1, 3)
+        distance = np.linalg.norm(fixes[known] - truth[known], axis=1)
+        errors[f"support-{system - 1}"] = spread([float(e) for e in distance])
+    return errors
+
+
 def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
     """The tlog-determined metrics of summary.json."""
     return trace_metrics(read_tlog(tlog, scenario), World(scenario))
@@ -291,6 +315,7 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "multipath_steps": counts,
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": spread([float(e) for e in errors]),
+        "support_gnss_error_m": support_gnss_errors(trace),
         "tracking_error_m": tracking_metrics(
             trace, world.scenario.control.s_max_work_m_s, world.scenario.control.s_max_support_m_s
         ),

@@ -19,6 +19,7 @@ class RunTrace:
     estimates: dict[float, np.ndarray] = field(default_factory=dict)  # the work UAV's, by time
     # every vehicle's belief (LOCAL_POSITION_NED), setpoints and the estimates sent before them
     beliefs: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    fixes: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)  # 3-D GNSS fixes
     setpoints: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     sent_estimates: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     cycles: set[float] = field(default_factory=set)  # times of the work UAV's setpoints

@@ -69,13 +69,13 @@ def detached_cycles(
         reports = []
         for name in context.support_waypoints:
             y = vehicles[name].truth
-            fix = world.gnss.sample_fix(y, rng, world.zone_offset(y[None])[0])
+            fix = world.gnss_fix(y, rng)
             observation = world.camera.observe(y, work_truth, rng)
             position = fix.position_m if fix.has_fix else None
             reports.append(SupportReport(name, position, observation.relative_m))
         work_fix = None
         if scenario.roles.policy == "dynamic":
-            fix = world.gnss.sample_fix(work_truth, own_rng, world.zone_offset(work_truth[None])[0])
+            fix = world.gnss_fix(work_truth, own_rng)
             work_fix = fix.position_m if fix.has_fix else None
         output = complete_cycle(state, control_cycle(state, reports, context, work_fix), context)
         yield output, work_truth.copy(), state.completed

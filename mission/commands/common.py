@@ -58,9 +58,10 @@ def realtime_speedup(args: argparse.Namespace) -> float | None:
 
 def preflight(scenario) -> None:
     """Everything a run reads from files, checked before any process starts: the structure's
-    mesh (loading the known world), every vehicle's waypoint file (the work UAV's the
-    scenario's path), the supports' own inspection waypoints against the structure, and,
-    with dynamic roles, that a released support can be recalled in time."""
+    mesh (loading the known world; every triangle with a normal where it reflects signals),
+    every vehicle's waypoint file (the work UAV's the scenario's path), the supports' own
+    inspection waypoints against the structure, and, with dynamic roles, that a released
+    support can be recalled in time."""
     from mission.link.plan_check import (
         check_inspections_placed,
         check_plan_files,
@@ -72,6 +73,10 @@ def preflight(scenario) -> None:
     from mission.world.model import KnownWorld
 
     world = KnownWorld(scenario)
+    if scenario.world.gnss.uses_geometry:
+        from mission.world.reflections import check_reflecting_faces
+
+        check_reflecting_faces(world.structure, scenario.source)
     check_work_waypoints_clear(world)
     names = vehicle_names(scenario.task.supports)
     check_plan_files(world, Path(scenario.task.waypoints_dir), names)

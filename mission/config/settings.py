@@ -28,6 +28,7 @@ from mission.config.role_settings import (
     check_waypoints,
 )
 from mission.config.sensor_settings import CameraSettings, GnssSettings, SkySettings
+from mission.config.signal_settings import SignalSettings
 from mission.config.wind_settings import WindSettings
 
 Vec3 = tuple[float, float, float]
@@ -149,6 +150,7 @@ class WorldSettings:
     structure: StructureSettings
     zones: list[Zone]
     wind: WindSettings
+    gnss: SignalSettings  # where the fixes' errors come from (zones, geometry or both)
 
     def __post_init__(self) -> None:
         extent = min(b - a for a, b in zip(self.workspace.min_m, self.workspace.max_m))
@@ -168,6 +170,11 @@ class WorldSettings:
         names = [z.name for z in self.zones]
         for i, name in enumerate(names):
             _require(names.index(name) == i, f"zones[{i}].name", f"duplicate zone name '{name}'")
+        _require(
+            self.gnss.uses_zones or not self.zones,
+            "gnss.multipath",
+            "'geometry' leaves the scenario's zones without effect: use 'both', or set zones: []",
+        )
 
 
 @dataclass(frozen=True)

@@ -64,6 +64,11 @@ class GnssModel:
         self._fix_geometry_by_mask: dict[bytes, tuple[np.ndarray | None, np.ndarray | None]] = {}
         self._geometry_by_mask: dict[bytes, tuple[bool, np.ndarray]] = {}
 
+    @property
+    def geometry_rows(self) -> np.ndarray:
+        """(S, 3 + constellations): each satellite's row of H, [-e^T, its clock's one-hot]."""
+        return self._rows
+
     def visibility(self, points: np.ndarray) -> np.ndarray:
         """(N, S) True where the satellite is above the mask and its ray misses the structure."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
@@ -204,6 +209,7 @@ class GnssFix:
     n_visible: int
     hdop: float | None
     vdop: float | None
+    solution: str = "rtk-fixed"  # or "rtk-float" / "code" (multipath from geometry)
 
 
 def _geometry_rows(directions: np.ndarray, system: np.ndarray, n_systems: int) -> np.ndarray:

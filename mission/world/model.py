@@ -1,9 +1,10 @@
 """The world of a scenario, in two kinds: what anyone may know of it (:class:`KnownWorld`:
 structure, sky, GNSS and camera models, workspace) and the simulated world (:class:`World`:
-the known world and the multipath zones).
+the known world and where GNSS errors come from: the multipath zones, reflections off the
+structure, or both).
 
-The ground station is built from a :class:`KnownWorld`, so the zones are out of its reach by
-type, not by a promise; the vehicles and analysis take a :class:`World`.
+The ground station is built from a :class:`KnownWorld`, so the multipath model is out of its
+reach by type, not by a promise; the vehicles and analysis take a :class:`World`.
 """
 
 from __future__ import annotations
@@ -18,8 +19,9 @@ import numpy as np
 from mission.config.scenario import load_scenario
 from mission.config.settings import Scenario
 from mission.world.camera import CameraModel
-from mission.world.gnss import GnssModel
+from mission.world.gnss import GnssFix, GnssModel
 from mission.world.grid import VoxelGrid
+from mission.world.multipath import GeometricReceiver
 from mission.world.sky import load_sky
 from mission.world.structure import Structure, build_structure
 from mission.world.zones import MultipathZones
@@ -113,13 +115,34 @@ class KnownWorld:
 
 
 class World(KnownWorld):
-    """The simulated world: the known world and the multipath zones, which bias the GNSS fixes
-    taken inside them. For the vehicles and for analysis; never for the ground station."""
+    """The simulated world: the known world and what biases GNSS fixes (``world.gnss``): the
+    multipath zones, the reflections off the structure and the ground, or both. For the
+    vehicles and for analysis; never for the ground station."""
 
     def __init__(self, scenario: Scenario) -> None:
         super().__init__(scenario)
         self.scenario = scenario
         self.zones = MultipathZones(scenario.world.zones)
+        signal = scenario.world.gnss
+        self.receiver = (
+            GeometricReceiver(self.gnss, signal, scenario.source) if signal.uses_geometry else None
+        )
+
+    def gnss_fix(
+        self,
+        truth: np.ndarray,
+        rng: np.random.Generator,
+        sigma_uere_m: float | None = None,
+        multipath_scale: float = 1.0,
+    ) -> GnssFix:
+        """A receiver's fix at ``truth``: noise of ``sigma_uere_m`` and the multipath of the
+        scenario's model times ``multipath_scale`` (a vehicle's SIM_MP_SCALE)."""
+        offset = self.zone_offset(truth[None])[0]
+        if multipath_scale != 1.0:
+            offset = multipath_scale * offset
+        if self.receiver is None:
+            return self.gnss.sample_fix(truth, rng, offset, sigma_uere_m=sigma_uere_m)
+        return self.receiver.sample_fix(truth, rng, offset, sigma_uere_m, multipath_scale)
 
     def known(self) -> KnownWorld:
         """This world without its zones (the same structure)."""
@@ -135,7 +158,10 @@ class World(KnownWorld):
 
 
 def without_zones(scenario: Scenario) -> Scenario:
-    """The scenario with no multipath zones (everything else the same)."""
-    if not scenario.world.zones:
+    """The scenario with no multipath model: no zones, and ``world.gnss.multipath`` at
+    ``zones`` (none of them), everything else the same."""
+    world = scenario.world
+    if not world.zones and world.gnss.multipath == "zones":
         return scenario
-    return dataclasses.replace(scenario, world=dataclasses.replace(scenario.world, zones=[]))
+    gnss = dataclasses.replace(world.gnss, multipath="zones")
+    return dataclasses.replace(scenario, world=dataclasses.replace(world, zones=[], gnss=gnss))

@@ -1,0 +1,188 @@
+"""First-order specular reflections of satellite signals off the structure and the ground
+(issue 47), found by the image method.
+
+A satellite is far enough to be a direction ``e`` (unit, receiver to satellite). For a plane
+with unit normal ``n`` facing the receiver at height ``h`` above it, the reflected signal
+comes from the receiver's mirror image: it leaves the plane at the specular point
+
+    s = p - 2 h n + (h / (n . e)) e
+
+and travels ``2 h (n . e)`` further than the direct one (the excess path: ``2 h sin(el)`` off
+the ground, ``2 d cos(el) cos(dAz)`` off a vertical wall). A reflection is received only when
+the satellite lies on the receiver's side of the plane (``n . e > 0``), the specular point
+lies on a face of the plane (the ground is one unbounded plane, z = 0), and neither leg, the
+satellite to the specular point nor the specular point to the receiver, meets the structure.
+
+Faces reflect on both sides (mesh files need not wind their triangles consistently); the
+structure's coplanar triangles (a box face's two) form one reflecting plane, so a specular
+point on their shared edge counts once. What depends on the satellites and the planes alone
+(``n . e``) is computed once: the sky is one epoch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mission.config.errors import ScenarioError
+from mission.world.structure import Structure
+
+LIFT_M = 1e-3  # legs start this far off a face, on its lit side, so that it does not block them
+_MIN_HEIGHT_M = 1e-6  # a receiver on a plane sees no reflection off it
+_INSIDE_TOLERANCE = 1e-9  # barycentric slack: a point on a triangle's edge is on it
+_MIN_AREA_M2 = 1e-12
+_CHUNK_CANDIDATES = 400_000
+
+
+@dataclass(frozen=True)
+class ReflectedPaths:
+    """The received reflections at N points, one row per reflection."""
+
+    point: np.ndarray  # (K,) index of the receiver point
+    satellite: np.ndarray  # (K,) index of the satellite (into the directions given)
+    plane: np.ndarray  # (K,) reflecting plane (the last index is the ground)
+    excess_m: np.ndarray  # (K,) extra path over the direct one
+    amplitude: np.ndarray  # (K,) field amplitude relative to a direct signal, antenna included
+    specular_m: np.ndarray  # (K, 3) where the signal reflects
+
+
+class Reflectors:
+    """The structure's reflecting planes and the ground, with their surfaces' amplitudes."""
+
+    def __init__(
+        self,
+        structure: Structure,
+        structure_amplitude: float,
+        ground_amplitude: float,
+        below_horizon_gain_db: float,
+        source: str = "",
+    ) -> None:
+        self.structure = structure
+        normals, offsets, order, starts = _planes(structure.vertices, structure.faces, source)
+        self.normals = np.vstack((normals, [[0.0, 0.0, 1.0]]))  # the ground last
+        self.offsets = np.append(offsets, 0.0)
+        self.ground = len(self.normals) - 1
+        self.amplitudes = np.append(np.full(len(normals), structure_amplitude), ground_amplitude)
+        self._below_horizon_gain = 10 ** (below_horizon_gain_db / 20)
+        triangles = structure.vertices[structure.faces[order]]  # sorted by plane
+        self._v0 = triangles[:, 0]
+        self._e1 = triangles[:, 1] - triangles[:, 0]
+        self._e2 = triangles[:, 2] - triangles[:, 0]
+        self._d00 = np.einsum("ij,ij->i", self._e1, self._e1)
+        self._d01 = np.einsum("ij,ij->i", self._e1, self._e2)
+        self._d11 = np.einsum("ij,ij->i", self._e2, self._e2)
+        self._denominator = self._d00 * self._d11 - self._d01**2
+        self._start = starts[:-1]  # first triangle of each structure plane
+        self._count = np.diff(starts)
+
+    def paths(self, points: np.ndarray, directions: np.ndarray) -> ReflectedPaths:
+        """Every received first-order reflection at ``points`` (N, 3) of the satellites in
+        ``directions`` (S, 3, unit, receiver to satellite)."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        directions = np.atleast_2d(np.asarray(directions, dtype=float))
+        per_point = max(1, len(directions) * len(self.normals))
+        step = max(1, _CHUNK_CANDIDATES // per_point)
+        parts = [
+            self._paths_chunk(points[start : start + step], directions, start)
+            for start in range(0, len(points), step)
+        ]
+        if not parts:
+            return _empty()
+        return ReflectedPaths(*(np.concatenate([getattr(p, f) for p in parts]) for f in _FIELDS))
+
+    def _paths_chunk(
+        self, points: np.ndarray, directions: np.ndarray, first: int
+    ) -> ReflectedPaths:
+        height = points @ self.normals.T - self.offsets  # (N, G), signed
+        side = np.where(height >= 0, 1.0, -1.0)
+        cosine = side[:, None, :] * (directions @ self.normals.T)[None]  # (N, S, G): n'.e
+        lit = (cosine > 0) & (np.abs(height) > _MIN_HEIGHT_M)[:, None, :]
+        i, s, g = np.nonzero(lit)
+        h = np.abs(height[i, g])
+        normal = side[i, g, None] * self.normals[g]  # facing the receiver
+        reach = h / cosine[i, s, g]  # the specular point's distance from the image
+        specular = points[i] - 2 * h[:, None] * normal + reach[:, None] * directions[s]
+        on_face = self._on_face(specular, g)
+        i, s, g, h, normal, specular = (a[on_face] for a in (i, s, g, h, normal, specular))
+        lifted = specular + LIFT_M * normal
+        blocked = self.structure.segments_blocked(points[i], lifted)
+        open_legs = ~blocked
+        open_legs[open_legs] = ~self.structure.rays_blocked(
+            lifted[open_legs], directions[s[open_legs]]
+        )
+        i, s, g, h, specular = (a[open_legs] for a in (i, s, g, h, specular))
+        excess = 2 * h * cosine[i, s, g]
+        arrival_below = specular[:, 2] < points[i, 2]
+        amplitude = self.amplitudes[g] * np.where(arrival_below, self._below_horizon_gain, 1.0)
+        return ReflectedPaths(i + first, s, g, excess, amplitude, specular)
+
+    def _on_face(self, specular: np.ndarray, plane: np.ndarray) -> np.ndarray:
+        """True where each specular point lies on a triangle of its plane (always on the
+        ground)."""
+        on = plane == self.ground
+        rows = np.flatnonzero(~on)
+        if len(rows) == 0:
+            return on
+        counts = self._count[plane[rows]]
+        owner = np.repeat(np.arange(len(rows)), counts)
+        firsts = np.cumsum(counts) - counts
+        triangle = np.repeat(self._start[plane[rows]], counts) + (
+            np.arange(counts.sum()) - np.repeat(firsts, counts)
+        )
+        offset = specular[rows][owner] - self._v0[triangle]
+        d20 = np.einsum("ij,ij->i", offset, self._e1[triangle])
+        d21 = np.einsum("ij,ij->i", offset, self._e2[triangle])
+        den = self._denominator[triangle]
+        v = (self._d11[triangle] * d20 - self._d01[triangle] * d21) / den
+        w = (self._d00[triangle] * d21 - self._d01[triangle] * d20) / den
+        inside = (v >= -_INSIDE_TOLERANCE) & (w >= -_INSIDE_TOLERANCE)
+        inside &= v + w <= 1 + _INSIDE_TOLERANCE
+        on[rows] = np.logical_or.reduceat(inside, firsts)
+        return on
+
+
+def check_reflecting_faces(structure: Structure, source: str = "") -> None:
+    """Refuse (ScenarioError) a structure with a triangle that has no normal."""
+    _planes(structure.vertices, structure.faces, source)
+
+
+_FIELDS = ("point", "satellite", "plane", "excess_m", "amplitude", "specular_m")
+
+
+def _empty() -> ReflectedPaths:
+    none = np.zeros(0, dtype=int)
+    return ReflectedPaths(none, none, none, np.zeros(0), np.zeros(0), np.zeros((0, 3)))
+
+
+def _planes(
+    vertices: np.ndarray, faces: np.ndarray, source: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The distinct planes of the triangles off the ground: unit normals (P, 3) with their
+    first non-zero component positive, offsets (P,) (n . x = offset on the plane), those
+    triangles' indices sorted by plane and each plane's first position in them (P + 1,)."""
+    corners = vertices[faces]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    doubled_area = np.linalg.norm(cross, axis=1)
+    flat = np.flatnonzero(doubled_area / 2 <= _MIN_AREA_M2)
+    if len(flat):
+        raise ScenarioError(
+            source,
+            "world.structure.mesh_file",
+            f"{len(flat)} triangle(s) have no normal (zero area; the first is face "
+            f"{int(flat[0])}): a reflecting surface needs one; remove them from the mesh",
+        )
+    normal = cross / doubled_area[:, None]
+    leading = np.argmax(np.abs(normal) > 1e-9, axis=1)
+    normal *= np.sign(normal[np.arange(len(normal)), leading])[:, None]
+    offset = np.einsum("ij,ij->i", normal, corners[:, 0])
+    # triangles on the ground's plane (a pier's footing) are the ground's to reflect
+    kept = np.flatnonzero(~((np.abs(normal[:, 2] - 1) < 1e-9) & (np.abs(offset) < 1e-4)))
+    key = np.column_stack((np.round(normal[kept], 6), np.round(offset[kept], 4)))
+    unique, plane_of = np.unique(key.reshape(-1, 4), axis=0, return_inverse=True)
+    plane_of = plane_of.reshape(-1)
+    ranked = np.argsort(plane_of, kind="stable")
+    order = kept[ranked]
+    starts = np.searchsorted(plane_of[ranked], np.arange(len(unique) + 1))
+    first = order[starts[:-1]]
+    return normal[first].reshape(-1, 3), offset[first], order, starts
