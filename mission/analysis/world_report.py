@@ -17,13 +17,37 @@ def point_report(world: World, point: np.ndarray) -> dict[str, Any]:
     visible = [sv for sv, seen in zip(world.sky.sv, geometry.visible[0]) if seen]
     fixed = bool(geometry.has_fix[0])
     pdop = float(geometry.pdop[0]) if fixed else None
-    return {
+    report = {
         "visible": visible,
         "n_visible": len(visible),
         "pdop": _rounded(pdop),
         "sigma_gnss_m": _rounded(world.scenario.gnss.sigma_uere_m * pdop if fixed else None),
         "in_zone": bool(world.in_zone(point)[0]),
     }
+    if world.receiver is not None:
+        report["multipath"] = _receiver_report(world, point)
+    return report
+
+
+def _receiver_report(world: World, point: np.ndarray) -> dict[str, Any]:
+    """What the geometry's receiver makes of the sky at ``point`` (no noise)."""
+    solution = world.receiver.solve(point)
+    sv = world.sky.sv
+    fixed = bool(solution.has_fix[0])
+    error = solution.range_error_m[0]
+    return {
+        "used": [s for s, used in zip(sv, solution.tracked[0]) if used],
+        "reflected": [s for s, nlos in zip(sv, solution.reflected[0]) if nlos],
+        "range_error_m": {s: round(float(e), 3) for s, e in zip(sv, error) if e != 0},
+        "solution": _solution_name(world, bool(solution.carrier_fixed[0])) if fixed else None,
+        "error_m": [round(float(v), 3) for v in solution.position_error_m[0]] if fixed else None,
+    }
+
+
+def _solution_name(world: World, carrier_fixed: bool) -> str:
+    if carrier_fixed:
+        return "rtk-fixed"
+    return "rtk-float" if world.scenario.world.gnss.solution == "rtk" else "code"
 
 
 def summary_text(world: World) -> str:
@@ -42,6 +66,10 @@ def summary_text(world: World) -> str:
     ]
     lines += [f"  {p.name:<10} {p.min_m} .. {p.max_m}" for p in w.structure.primitives]
     lines.append(f"zones      {len(w.zones)} (known to the vehicles only)")
+    lines.append(
+        f"multipath  {w.gnss.multipath} (known to the vehicles only); structure "
+        f"{w.gnss.structure_surface}, ground {w.gnss.ground_surface}, {w.gnss.solution} receiver"
+    )
     lines += [f"  {z.name:<10} {z.min_m} .. {z.max_m}  offset {z.offset_m} m" for z in w.zones]
     sky = world.sky
     counts = {

@@ -19,6 +19,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.bench.floor import RUN_CPU_TARGET_S, bench_floor
 from mission.bench.integrity import bench_integrity
 from mission.bench.margins import bench_margins
+from mission.bench.multipath import bench_multipath
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
 from mission.bench.study import bench_studies
@@ -356,6 +357,7 @@ BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "margins": bench_margins,
     "roles": bench_roles,
     "integrity": bench_integrity,
+    "multipath": bench_multipath,
     "run": bench_runs,
     "floor": bench_floor,
     "study": bench_studies,

@@ -20,6 +20,7 @@ def add_parser(commands) -> None:
             "margins",
             "roles",
             "integrity",
+            "multipath",
             "run",
             "floor",
             "study",

@@ -36,6 +36,13 @@ def add_parser(commands) -> None:
         metavar="FILE.png|pdf|svg",
         help="draw structure, zones, sky plot and sigma_0 slices",
     )
+    parser.add_argument(
+        "--multipath-map",
+        type=Path,
+        metavar="FILE.png|pdf|svg",
+        help="draw the GNSS error reflections make on slices at the mission's heights, and "
+        "the sky at the worst point (with zones, as the geometry model would make it)",
+    )
     parser.set_defaults(handler=world)
 
 
@@ -46,6 +53,8 @@ def world(args: argparse.Namespace) -> int:
 
     if args.plot is not None:
         check_figure_path(args.plot, "--plot")
+    if args.multipath_map is not None:
+        check_figure_path(args.multipath_map, "--multipath-map")
     world = World.load(args.scenario)
     if point is not None:
         from mission.analysis.world_report import point_report
@@ -67,4 +76,13 @@ def world(args: argparse.Namespace) -> int:
 
         plot_world(world, np.array(point or DEFAULT_PLOT_POINT), args.plot)
         print(f"wrote {args.plot}", file=sys.stderr if point is not None else sys.stdout)
+    if args.multipath_map is not None:
+        from mission.analysis.multipath_plot import plot_multipath
+
+        worst = plot_multipath(world, args.multipath_map)
+        print(
+            f"wrote {args.multipath_map} (worst error {worst['worst_m']:g} m at "
+            f"{worst['x']:g}, {worst['y']:g}, {worst['z']:g})",
+            file=sys.stderr if point is not None else sys.stdout,
+        )
     return 0

@@ -123,6 +123,8 @@ def below_margin_path(first: str, second: str) -> str:
 
 
 G_PATH = "map/G"
+GNSS_ERROR_PATH = "map/gnss_error"  # the true error field beside G (multipath from geometry)
+GNSS_ERROR_RANGE_M = (0.0, 20.0)  # its colour scale; a voxel without a fix shows the top
 WORST_PATH = "safety/worst_approach"  # between the two UAVs of the worst approach so far
 
 

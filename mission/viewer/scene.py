@@ -28,6 +28,9 @@ class Scene:
     voxel_m: float
     wind: np.ndarray  # the free stream (ENU, m/s); zeros in still air
     inspections: dict[str, np.ndarray] = field(default_factory=dict)  # a support's own, (n, 3)
+    # the true GNSS error field where the multipath comes from geometry: voxel indices (n, 3)
+    # and |error| there (n,), the voxels above GNSS_ERROR_SHOWN_M only; None with zones
+    gnss_error: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def build_scene(scenario: Scenario, world: World) -> Scene:
@@ -52,4 +55,23 @@ def build_scene(scenario: Scenario, world: World) -> Scene:
         voxel_m=float(grid.voxel_m),
         wind=WindField(scenario.world.wind, []).free_stream,
         inspections={i.vehicle: np.array(i.waypoints_m) for i in scenario.task.inspections},
+        gnss_error=gnss_error_voxels(world),
     )
+
+
+GNSS_ERROR_SHOWN_M = 0.5  # the error field's voxels shown from this error up
+
+
+def gnss_error_voxels(world: World) -> tuple[np.ndarray, np.ndarray] | None:
+    """The receiver's error (no noise) at every voxel centre of G's grid, where it is at least
+    GNSS_ERROR_SHOWN_M or there is no fix (shown as NaN), outside the structure; None where
+    the multipath comes from zones alone."""
+    if world.receiver is None:
+        return None
+    grid = world.map_grid()
+    centers = grid.centers().reshape(-1, 3)
+    solution = world.receiver.solve(centers)
+    error = np.linalg.norm(solution.position_error_m, axis=1)  # NaN without a fix
+    shown = ~(error < GNSS_ERROR_SHOWN_M) & ~world.structure.contains(centers)
+    indices = np.argwhere(shown.reshape(grid.shape))
+    return indices, error[shown]

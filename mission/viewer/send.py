@@ -53,6 +53,21 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
             ),
             static=True,
         )
+    if scene.gnss_error is not None:
+        indices, values = scene.gnss_error
+        rec.log(
+            f.GNSS_ERROR_PATH,
+            rr.VoxelGridMap(
+                voxel_indices=indices.astype(np.int32).reshape(-1, 3),
+                voxel_size=[scene.voxel_m] * 3,
+                values=np.nan_to_num(values, nan=f.GNSS_ERROR_RANGE_M[1]).astype(np.float32),
+                translation=scene.voxel_origin,
+                value_range=f.GNSS_ERROR_RANGE_M,
+                colormap="magma",
+                opacity=0.25,
+            ),
+            static=True,
+        )
     low, high = scene.workspace
     rec.log(
         "world/workspace",

@@ -72,6 +72,7 @@ class GeometricReceiver:
         self._system = sky.constellation_index()
         self.reflectors = Reflectors(
             gnss.structure,
+            self._directions,
             signal.amplitude.of(signal.structure_surface),
             signal.amplitude.of(signal.ground_surface),
             signal.antenna_below_horizon_db,
@@ -80,7 +81,7 @@ class GeometricReceiver:
 
     def paths(self, points: np.ndarray) -> ReflectedPaths:
         """The received reflections at ``points``, satellites indexed as in the sky."""
-        found = self.reflectors.paths(points, self._directions)
+        found = self.reflectors.paths(points)
         return ReflectedPaths(
             found.point,
             self._above[found.satellite],

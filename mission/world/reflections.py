@@ -32,7 +32,8 @@ LIFT_M = 1e-3  # legs start this far off a face, on its lit side, so that it doe
 _MIN_HEIGHT_M = 1e-6  # a receiver on a plane sees no reflection off it
 _INSIDE_TOLERANCE = 1e-9  # barycentric slack: a point on a triangle's edge is on it
 _MIN_AREA_M2 = 1e-12
-_CHUNK_CANDIDATES = 400_000
+_CHUNK_CANDIDATES = 400_000  # (point, satellite, plane, triangle) tuples at a time
+_SKY_M = 1.0e6  # a leg to a satellite: far beyond any structure
 
 
 @dataclass(frozen=True)
@@ -48,98 +49,112 @@ class ReflectedPaths:
 
 
 class Reflectors:
-    """The structure's reflecting planes and the ground, with their surfaces' amplitudes."""
+    """The structure's reflecting planes and the ground, with their surfaces' amplitudes, for
+    one sky (the satellites' directions, fixed for the epoch)."""
 
     def __init__(
         self,
         structure: Structure,
+        directions: np.ndarray,
         structure_amplitude: float,
         ground_amplitude: float,
         below_horizon_gain_db: float,
         source: str = "",
     ) -> None:
         self.structure = structure
+        self.directions = np.atleast_2d(np.asarray(directions, dtype=float))
         normals, offsets, order, starts = _planes(structure.vertices, structure.faces, source)
         self.normals = np.vstack((normals, [[0.0, 0.0, 1.0]]))  # the ground last
         self.offsets = np.append(offsets, 0.0)
         self.ground = len(self.normals) - 1
         self.amplitudes = np.append(np.full(len(normals), structure_amplitude), ground_amplitude)
         self._below_horizon_gain = 10 ** (below_horizon_gain_db / 20)
-        triangles = structure.vertices[structure.faces[order]]  # sorted by plane
-        self._v0 = triangles[:, 0]
-        self._e1 = triangles[:, 1] - triangles[:, 0]
-        self._e2 = triangles[:, 2] - triangles[:, 0]
-        self._d00 = np.einsum("ij,ij->i", self._e1, self._e1)
-        self._d01 = np.einsum("ij,ij->i", self._e1, self._e2)
-        self._d11 = np.einsum("ij,ij->i", self._e2, self._e2)
-        self._denominator = self._d00 * self._d11 - self._d01**2
-        self._start = starts[:-1]  # first triangle of each structure plane
-        self._count = np.diff(starts)
+        self._cosine = self.directions @ self.normals.T  # (S, G): n . e, once for the sky
+        self._triangles = _PaddedTriangles(structure.vertices[structure.faces[order]], starts)
 
-    def paths(self, points: np.ndarray, directions: np.ndarray) -> ReflectedPaths:
-        """Every received first-order reflection at ``points`` (N, 3) of the satellites in
-        ``directions`` (S, 3, unit, receiver to satellite)."""
+    def paths(self, points: np.ndarray) -> ReflectedPaths:
+        """Every received first-order reflection at ``points`` (N, 3)."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
-        directions = np.atleast_2d(np.asarray(directions, dtype=float))
-        per_point = max(1, len(directions) * len(self.normals))
+        per_point = max(1, self._cosine.size * self._triangles.width)
         step = max(1, _CHUNK_CANDIDATES // per_point)
         parts = [
-            self._paths_chunk(points[start : start + step], directions, start)
+            self._paths_chunk(points[start : start + step], start)
             for start in range(0, len(points), step)
         ]
+        if len(parts) == 1:
+            return parts[0]
         if not parts:
             return _empty()
         return ReflectedPaths(*(np.concatenate([getattr(p, f) for p in parts]) for f in _FIELDS))
 
-    def _paths_chunk(
-        self, points: np.ndarray, directions: np.ndarray, first: int
-    ) -> ReflectedPaths:
+    def _paths_chunk(self, points: np.ndarray, first: int) -> ReflectedPaths:
         height = points @ self.normals.T - self.offsets  # (N, G), signed
         side = np.where(height >= 0, 1.0, -1.0)
-        cosine = side[:, None, :] * (directions @ self.normals.T)[None]  # (N, S, G): n'.e
+        cosine = side[:, None, :] * self._cosine  # (N, S, G): n'.e, n' facing the receiver
         lit = (cosine > 0) & (np.abs(height) > _MIN_HEIGHT_M)[:, None, :]
         i, s, g = np.nonzero(lit)
         h = np.abs(height[i, g])
-        normal = side[i, g, None] * self.normals[g]  # facing the receiver
-        reach = h / cosine[i, s, g]  # the specular point's distance from the image
-        specular = points[i] - 2 * h[:, None] * normal + reach[:, None] * directions[s]
-        on_face = self._on_face(specular, g)
-        i, s, g, h, normal, specular = (a[on_face] for a in (i, s, g, h, normal, specular))
+        cos = cosine[i, s, g]
+        normal = side[i, g, None] * self.normals[g]
+        specular = points[i] + (h / cos)[:, None] * self.directions[s] - (2 * h)[:, None] * normal
+        on = (g == self.ground) | self._triangles.hold(specular, g)
+        i, s, g, h, cos, normal, specular = (a[on] for a in (i, s, g, h, cos, normal, specular))
         lifted = specular + LIFT_M * normal
-        blocked = self.structure.segments_blocked(points[i], lifted)
-        open_legs = ~blocked
-        open_legs[open_legs] = ~self.structure.rays_blocked(
-            lifted[open_legs], directions[s[open_legs]]
-        )
-        i, s, g, h, specular = (a[open_legs] for a in (i, s, g, h, specular))
-        excess = 2 * h * cosine[i, s, g]
-        arrival_below = specular[:, 2] < points[i, 2]
-        amplitude = self.amplitudes[g] * np.where(arrival_below, self._below_horizon_gain, 1.0)
+        open_legs = ~self._legs_blocked(points[i], lifted, self.directions[s])
+        i, s, g, specular = i[open_legs], s[open_legs], g[open_legs], specular[open_legs]
+        excess = 2 * (h * cos)[open_legs]
+        below = specular[:, 2] < points[i, 2]  # arriving from below the antenna's horizon
+        amplitude = self.amplitudes[g] * np.where(below, self._below_horizon_gain, 1.0)
         return ReflectedPaths(i + first, s, g, excess, amplitude, specular)
 
-    def _on_face(self, specular: np.ndarray, plane: np.ndarray) -> np.ndarray:
-        """True where each specular point lies on a triangle of its plane (always on the
-        ground)."""
-        on = plane == self.ground
-        rows = np.flatnonzero(~on)
-        if len(rows) == 0:
-            return on
-        counts = self._count[plane[rows]]
-        owner = np.repeat(np.arange(len(rows)), counts)
-        firsts = np.cumsum(counts) - counts
-        triangle = np.repeat(self._start[plane[rows]], counts) + (
-            np.arange(counts.sum()) - np.repeat(firsts, counts)
-        )
-        offset = specular[rows][owner] - self._v0[triangle]
-        d20 = np.einsum("ij,ij->i", offset, self._e1[triangle])
-        d21 = np.einsum("ij,ij->i", offset, self._e2[triangle])
-        den = self._denominator[triangle]
-        v = (self._d11[triangle] * d20 - self._d01[triangle] * d21) / den
-        w = (self._d00[triangle] * d21 - self._d01[triangle] * d20) / den
+    def _legs_blocked(self, points: np.ndarray, lifted: np.ndarray, sky: np.ndarray) -> np.ndarray:
+        """Whether the leg from each point to its specular point, or the one from there to
+        the satellite, meets the structure: both in one query."""
+        n = len(points)
+        if n == 0:
+            return np.zeros(0, dtype=bool)
+        delta = lifted - points
+        length = np.sqrt(np.einsum("ij,ij->i", delta, delta))
+        origins = np.concatenate((points, lifted))
+        directions = np.concatenate((delta / length[:, None], sky))
+        reach = np.concatenate((length, np.full(n, _SKY_M)))
+        blocked = self.structure.rays.occluded(origins, directions, reach)
+        return blocked[:n] | blocked[n:]
+
+
+class _PaddedTriangles:
+    """Each reflecting plane's triangles, padded to the largest count (a padding triangle
+    holds nothing), for a point-on-face test without per-candidate loops."""
+
+    def __init__(self, triangles: np.ndarray, starts: np.ndarray) -> None:
+        counts = np.diff(starts)
+        self.width = max(1, int(counts.max(initial=0)))
+        planes = len(counts) + 1  # the ground's row stays empty
+        slot = np.arange(len(triangles)) - np.repeat(starts[:-1], counts)
+        plane = np.repeat(np.arange(len(counts)), counts)
+        self.v0 = np.zeros((planes, self.width, 3))
+        self.e1 = np.zeros((planes, self.width, 3))
+        self.e2 = np.zeros((planes, self.width, 3))
+        self.v0[plane, slot] = triangles[:, 0]
+        self.e1[plane, slot] = triangles[:, 1] - triangles[:, 0]
+        self.e2[plane, slot] = triangles[:, 2] - triangles[:, 0]
+        self.d00 = np.einsum("ptj,ptj->pt", self.e1, self.e1)
+        self.d01 = np.einsum("ptj,ptj->pt", self.e1, self.e2)
+        self.d11 = np.einsum("ptj,ptj->pt", self.e2, self.e2)
+        denominator = self.d00 * self.d11 - self.d01**2
+        self.valid = denominator > 0
+        self.inverse = np.where(self.valid, 1.0 / np.where(self.valid, denominator, 1.0), 0.0)
+
+    def hold(self, points: np.ndarray, plane: np.ndarray) -> np.ndarray:
+        """Whether each point (on its plane) lies on one of that plane's triangles."""
+        offset = points[:, None, :] - self.v0[plane]  # (K, T, 3)
+        d20 = np.einsum("ktj,ktj->kt", offset, self.e1[plane])
+        d21 = np.einsum("ktj,ktj->kt", offset, self.e2[plane])
+        v = (self.d11[plane] * d20 - self.d01[plane] * d21) * self.inverse[plane]
+        w = (self.d00[plane] * d21 - self.d01[plane] * d20) * self.inverse[plane]
         inside = (v >= -_INSIDE_TOLERANCE) & (w >= -_INSIDE_TOLERANCE)
-        inside &= v + w <= 1 + _INSIDE_TOLERANCE
-        on[rows] = np.logical_or.reduceat(inside, firsts)
-        return on
+        inside &= (v + w <= 1 + _INSIDE_TOLERANCE) & self.valid[plane]
+        return inside.any(axis=1)
 
 
 def check_reflecting_faces(structure: Structure, source: str = "") -> None:

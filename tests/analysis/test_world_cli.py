@@ -89,3 +89,28 @@ def test_the_command_runs_as_a_process_too():
     )
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["n_visible"] == 15
+
+
+def test_a_geometry_world_reports_its_receiver_at_a_point(capsys):
+    status, out, err = _mission(capsys, "world", "river", "--at", "0", "0", "7")
+    assert status == 0, err
+    multipath = json.loads(out)["multipath"]
+    assert multipath["reflected"] == multipath["used"] and len(multipath["used"]) >= 5
+    assert multipath["solution"] == "rtk-float"
+    assert multipath["error_m"] == pytest.approx([0.0, 0.0, -14.0], abs=1e-3)  # the mirror
+
+
+def test_the_multipath_map_is_drawn_and_names_its_worst_point(tmp_path, capsys):
+    figure = tmp_path / "multipath.png"
+    status, out, err = _mission(capsys, "world", "river", "--multipath-map", str(figure))
+    assert status == 0, err
+    assert "multipath  geometry" in out and f"wrote {figure} (worst error" in out
+    worst = float(out.split("worst error ")[1].split(" m")[0])
+    assert 5.0 < worst < 60.0  # under the deck: the published 5-30 m, and a pier's corner
+    header = figure.read_bytes()[:24]
+    assert header[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_bad_multipath_map_path_is_refused_before_anything_is_computed(tmp_path, capsys):
+    status, _, err = _mission(capsys, "world", "river", "--multipath-map", str(tmp_path / "m.txt"))
+    assert status == 2 and "--multipath-map" in err and len(err.strip().splitlines()) == 1

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from mission.bench import suite as bench
@@ -236,3 +237,29 @@ def test_the_floor_refuses_a_detached_run_that_did_not_finish(monkeypatch):
     monkeypatch.setattr(machine_speed, "python_loop_s", lambda repeats: 0.146)
     with pytest.raises(RuntimeError, match="did not finish in 1000 cycles"):
         floor.bench_floor(repeats=1)
+
+
+def test_the_multipath_row_times_the_same_fixes_by_both_models_in_turn(monkeypatch):
+    """Two fake worlds whose fixes cost 1 and 2 ms of (faked) CPU: 200 fixes cost 0.2 and
+    0.4 s, made in turns by blocks of 50, the one asked for first."""
+    from mission.bench import multipath
+
+    clock = {"t": 0.0}
+    cost = {"zones": 0.001, "geometry": 0.002}
+    order = []
+
+    class Fake:
+        def __init__(self, name):
+            self.name = name
+
+        def gnss_fix(self, point, rng):
+            clock["t"] += cost[self.name]
+            if not order or order[-1] != self.name:
+                order.append(self.name)
+
+    monkeypatch.setattr(multipath.time, "process_time", lambda: clock["t"])
+    worlds = {"zones": Fake("zones"), "geometry": Fake("geometry")}
+    positions = np.zeros((200, 3))
+    spent = multipath._time_fixes(worlds, positions, first="geometry")
+    assert spent == pytest.approx({"zones": 0.2, "geometry": 0.4})
+    assert order[:3] == ["geometry", "zones", "geometry"] and len(order) == 8  # blocks of 50

@@ -41,11 +41,12 @@ FAR_AWAY = ((5000.0, 5000.0, 0.0), (5001.0, 5001.0, 1.0))  # a structure that re
 
 def test_the_ground_bounce_is_2h_sin_e_over_random_geometries():
     rng = np.random.default_rng(1)
-    reflectors = Reflectors(_structure(FAR_AWAY), 0.5, 0.5, 0.0)
+    structure = _structure(FAR_AWAY)
     for _ in range(50):
         point = np.array([rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(0.5, 30)])
         directions = _directions(rng, 12)
-        paths = reflectors.paths(point[None], directions)
+        reflectors = Reflectors(structure, directions, 0.5, 0.5, 0.0)
+        paths = reflectors.paths(point[None])
         ground = paths.plane == reflectors.ground
         assert ground.sum() == 12  # every satellite above the horizon bounces off it
         expected = 2 * point[2] * directions[paths.satellite[ground], 2]
@@ -57,7 +58,7 @@ def test_a_wall_reflects_2d_cos_e_cos_daz_over_random_geometries():
     """The face x = 0 of a wall (normal pointing east, azimuth 90 degrees)."""
     rng = np.random.default_rng(2)
     wall = ((-1.0, -500.0, 0.0), (0.0, 500.0, 400.0))
-    reflectors = Reflectors(_structure(wall), 0.5, 0.0, 0.0)  # the ground's amplitude 0
+    structure = _structure(wall)
     checked = 0
     for _ in range(50):
         d = rng.uniform(0.5, 40)
@@ -71,7 +72,8 @@ def test_a_wall_reflects_2d_cos_e_cos_daz_over_random_geometries():
                 np.sin(elevation),
             )
         )
-        paths = reflectors.paths(point[None], directions)
+        reflectors = Reflectors(structure, directions, 0.5, 0.0, 0.0)
+        paths = reflectors.paths(point[None])
         off_wall = paths.plane != reflectors.ground
         cos_incidence = np.cos(elevation) * np.cos(azimuth - np.pi / 2)  # n . e
         reach = d / np.where(cos_incidence > 0, cos_incidence, np.inf)
@@ -93,26 +95,27 @@ def test_a_specular_point_off_the_face_or_a_blocked_leg_gives_no_reflection():
     plate. A box between the receiver and the plate blocks the first leg."""
     plate = ((-0.2, -1.0, 4.0), (0.0, 1.0, 6.0))
     east_low = np.array([[np.cos(np.radians(5)), 0.0, np.sin(np.radians(5))]])
-    reflectors = Reflectors(_structure(plate), 0.5, 0.0, 0.0)
-    on = reflectors.paths(np.array([[5.0, 0.0, 5.0]]), east_low)
+    reflectors = Reflectors(_structure(plate), east_low, 0.5, 0.0, 0.0)
+    on = reflectors.paths(np.array([[5.0, 0.0, 5.0]]))
     assert (on.plane != reflectors.ground).sum() == 1
     assert on.specular_m[on.plane != reflectors.ground][0] == pytest.approx(
         [0.0, 0.0, 5.0 + 5.0 * np.tan(np.radians(5))], abs=1e-9
     )
-    off = reflectors.paths(np.array([[5.0, 3.0, 5.0]]), east_low)
+    off = reflectors.paths(np.array([[5.0, 3.0, 5.0]]))
     assert (off.plane != reflectors.ground).sum() == 0
     blocker = ((2.0, -0.5, 4.0), (2.5, 0.5, 6.0))
-    blocked = Reflectors(_structure(plate, blocker), 0.5, 0.0, 0.0)
-    found = blocked.paths(np.array([[5.0, 0.0, 5.0]]), east_low)
+    blocked = Reflectors(_structure(plate, blocker), east_low, 0.5, 0.0, 0.0)
+    found = blocked.paths(np.array([[5.0, 0.0, 5.0]]))
     assert _plane(blocked, 0.0) not in found.plane  # only the blocker's own face reflects
     assert _plane(blocked, 2.5) in found.plane
     # a box over the specular point blocks the leg to the satellite instead
     roof = ((0.0, -1.0, 5.2), (4.0, 1.0, 5.4))
-    covered = Reflectors(_structure(plate, roof), 0.5, 0.0, 0.0)
     steep = np.array([[np.cos(np.radians(30)), 0.0, np.sin(np.radians(30))]])
+    open_plate = Reflectors(_structure(plate), steep, 0.5, 0.0, 0.0)
+    covered = Reflectors(_structure(plate, roof), steep, 0.5, 0.0, 0.0)
     under_roof = np.array([[1.0, 0.0, 4.5]])
-    assert _plane(reflectors, 0.0) in reflectors.paths(under_roof, steep).plane
-    assert _plane(covered, 0.0) not in covered.paths(under_roof, steep).plane
+    assert _plane(open_plate, 0.0) in open_plate.paths(under_roof).plane
+    assert _plane(covered, 0.0) not in covered.paths(under_roof).plane
 
 
 def _plane(reflectors: Reflectors, x: float) -> int:
