@@ -1,1 +1,1 @@
-"""The ground-station process (never sees zones or truth). Imports: config, world, link, procs."""
+"""The ground station (sees no zones nor truth). Imports: config, world, link, procs, maths."""

@@ -22,6 +22,7 @@ SHORT_NAMES = {  # the names the docstrings use for the project's packages
     "world": "mission.world",
     "link": "mission.link",
     "procs": "mission.procs",
+    "maths": "mission.maths",
     "analysis": "mission.analysis",
     "planning": "mission.planning",
     "runs": "mission.runs",

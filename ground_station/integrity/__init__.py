@@ -1,1 +1,1 @@
-"""Integrity: each support's fix tested, excluded, restored. Imports: config, ground_station."""
+"""Integrity: each fix tested, excluded, restored. Imports: config, maths, ground_station."""

@@ -29,7 +29,6 @@ import numpy as np
 from ground_station.fusion import FusionResult, SupportMeasurement
 from ground_station.gnss_map import LocalizabilityMap
 from ground_station.integrity.aftermath import learn_excluded, settle
-from ground_station.integrity.chi_square import detectable_noncentrality, gate
 from ground_station.integrity.consistency import Formation, Innovation, motion_innovation
 from ground_station.integrity.protection import (
     detectable_bias,
@@ -37,6 +36,7 @@ from ground_station.integrity.protection import (
 from ground_station.integrity.verdict import Event, Verdict, Watch
 from ground_station.state import StationState
 from mission.config.integrity_settings import IntegritySettings
+from mission.maths.chi_square import detectable_noncentrality, gate
 
 SUSPECT_EXPONENT = 0.5  # the suspect gate's false-alarm rate is false_alarm ** this
 TESTS = ("motion", "formation")

@@ -1,1 +1,1 @@
-"""Analysis of runs and worlds: tlog metrics, figures. Imports: config, world, link, procs."""
+"""Analysis of runs and worlds: metrics, figures. Imports: config, world, link, procs, maths."""

@@ -25,6 +25,7 @@ import numpy as np
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.analysis.gnss_errors import gnss_error_metrics
 from mission.analysis.safety import safety_metrics
 from mission.analysis.spread import spread
 from mission.analysis.trace import RunTrace
@@ -284,19 +285,6 @@ def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
     return np.array(times)[known], errors
 
 
-def support_gnss_errors(trace: RunTrace) -> dict[str, dict[str, float | None]]:
-    """Per support, |fix - truth| of every 3-D fix it reported (mean, p95, max): its
-    receiver's true error, whatever made it (zones, reflections, noise, faults)."""
-    errors = {}
-    for system in trace.supports:
-        times = sorted(t for s, t in trace.fixes if s == system)
-        truth, known = trace.truth_at(system, times)
-        fixes = np.array([trace.fixes[(system, t)] for t in times]).reshape(-1, 3)
-        distance = np.linalg.norm(fixes[known] - truth[known], axis=1)
-        errors[f"support-{system - 1}"] = spread([float(e) for e in distance])
-    return errors
-
-
 def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
     """The tlog-determined metrics of summary.json."""
     return trace_metrics(read_tlog(tlog, scenario), World(scenario))
@@ -315,7 +303,7 @@ def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         "multipath_steps": counts,
         "multipath_steps_total": int(sum(counts.values())),
         "work_error_m": spread([float(e) for e in errors]),
-        "support_gnss_error_m": support_gnss_errors(trace),
+        **gnss_error_metrics(trace, world),
         "tracking_error_m": tracking_metrics(
             trace, world.scenario.control.s_max_work_m_s, world.scenario.control.s_max_support_m_s
         ),

@@ -30,7 +30,7 @@ def bench_multipath(repeats: int = 3) -> list[BenchResult]:
     """The geometry run's CPU over the zones run's (median of ``repeats`` timings of the same
     fixes) and the geometry model's cost per fix (a reference)."""
     from mission.analysis.metrics import read_tlog
-    from mission.bench.suite import run_as_command
+    from mission.bench.run_command import run_as_command
     from mission.config.scenario import load_scenario
     from mission.procs.machine_speed import children_cpu_s
     from mission.world.model import World

@@ -12,7 +12,7 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TextIO
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
@@ -22,11 +22,10 @@ from mission.bench.margins import bench_margins
 from mission.bench.multipath import bench_multipath
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
+from mission.bench.run_command import run_as_command
 from mission.bench.study import bench_studies
 from mission.bench.view import bench_view
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
-from mission.procs.cli_common import child_environment
-from mission.procs.commands import mission_run_argv
 from mission.procs.machine_speed import REFERENCE_LOOP_S, children_cpu_s, python_loop_s
 from mission.procs.stopping import stop_processes
 
@@ -336,18 +335,6 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
             "table3_wall_s_estimate", estimate, "s", t3_target, estimate <= TABLE3_WALL_TARGET_S
         ),
     ]
-
-
-def run_as_command(
-    scenario: str, method: str, out: Path, mpc_helper: bool | None = None
-) -> dict[str, Any]:
-    """The summary of ``mission run SCENARIO --method METHOD --seed 0 --out OUT``, a fresh
-    process (this one may have threads that keep it from forking vehicles)."""
-    import json
-
-    command = mission_run_argv(scenario, out, method, 0, mpc_helper, ["--exit-with-parent"])
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=child_environment())
-    return json.loads((out / "summary.json").read_text())
 
 
 BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {

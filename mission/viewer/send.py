@@ -53,21 +53,7 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
             ),
             static=True,
         )
-    if scene.gnss_error is not None:
-        indices, values = scene.gnss_error
-        rec.log(
-            f.GNSS_ERROR_PATH,
-            rr.VoxelGridMap(
-                voxel_indices=indices.astype(np.int32).reshape(-1, 3),
-                voxel_size=[scene.voxel_m] * 3,
-                values=np.nan_to_num(values, nan=f.GNSS_ERROR_RANGE_M[1]).astype(np.float32),
-                translation=scene.voxel_origin,
-                value_range=f.GNSS_ERROR_RANGE_M,
-                colormap="magma",
-                opacity=0.25,
-            ),
-            static=True,
-        )
+    _send_gnss_error(rec, scene)
     low, high = scene.workspace
     rec.log(
         "world/workspace",
@@ -90,6 +76,26 @@ def send_scene(rec: rr.RecordingStream, scene: Scene) -> None:
                 rec.log(f.scalar_path(kind, name), series, static=True)
     series = rr.SeriesLines(colors=f.WORK_COLOUR, names=_SERIES["work_error"])
     rec.log(f.scalar_path("work_error"), series, static=True)
+
+
+def _send_gnss_error(rec: rr.RecordingStream, scene: Scene) -> None:
+    """The true GNSS error field (multipath from geometry) as voxels beside G."""
+    if scene.gnss_error is None:
+        return
+    indices, values = scene.gnss_error
+    rec.log(
+        f.GNSS_ERROR_PATH,
+        rr.VoxelGridMap(
+            voxel_indices=indices.astype(np.int32).reshape(-1, 3),
+            voxel_size=[scene.voxel_m] * 3,
+            values=np.nan_to_num(values, nan=f.GNSS_ERROR_RANGE_M[1]).astype(np.float32),
+            translation=scene.voxel_origin,
+            value_range=f.GNSS_ERROR_RANGE_M,
+            colormap="magma",
+            opacity=0.25,
+        ),
+        static=True,
+    )
 
 
 def _send_plans(rec: rr.RecordingStream, scene: Scene) -> None:

@@ -13,16 +13,16 @@ from scipy import stats
 
 from ground_station.fusion import SupportMeasurement
 from ground_station.gnss_map import LocalizabilityMap
-from ground_station.integrity.chi_square import (
+from ground_station.integrity.monitor import IntegrityMonitor
+from ground_station.state import StationState
+from ground_station.support_mpc.margins import widened
+from mission.config.settings import MapSettings
+from mission.maths.chi_square import (
     detectable_noncentrality,
     gate,
     noncentral_cdf_3,
     survival,
 )
-from ground_station.integrity.monitor import IntegrityMonitor
-from ground_station.state import StationState
-from ground_station.support_mpc.margins import widened
-from mission.config.settings import MapSettings
 from mission.world.grid import VoxelGrid
 
 SIGMA_GNSS = np.diag([0.01, 0.01, 0.04])  # m^2

@@ -1,0 +1,22 @@
+"""A run made as a user makes it, for the benchmarks that time whole runs."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+from typing import Any
+
+from mission.procs.cli_common import child_environment
+from mission.procs.commands import mission_run_argv
+
+
+def run_as_command(
+    scenario: str, method: str, out: Path, mpc_helper: bool | None = None
+) -> dict[str, Any]:
+    """The summary of ``mission run SCENARIO --method METHOD --seed 0 --out OUT``, a fresh
+    process (this one may have threads that keep it from forking vehicles)."""
+    import json
+
+    command = mission_run_argv(scenario, out, method, 0, mpc_helper, ["--exit-with-parent"])
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=child_environment())
+    return json.loads((out / "summary.json").read_text())

@@ -1,0 +1,1 @@
+"""Mathematics every role may use (distributions, tests). Imports: nothing."""
