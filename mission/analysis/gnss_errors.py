@@ -1,7 +1,9 @@
 """The supports' true GNSS errors in a run (issue 47), from the tlog: every 3-D fix a support
 reported against its truth at that step.
 
+- ``gnss_multipath``: where the errors came from (the scenario's ``world.gnss.multipath``);
 - ``support_gnss_error_m``: per support, mean, p95 and max of |fix - truth|;
+  ``supports_gnss_error_m`` the same over all supports' fixes;
 - ``gnss_error_steps``: per support, the fixes whose error exceeds ``detectable_bias_m``, the
   integrity monitor's motion test's minimal detectable bias in its best direction in the open
   sky (lambda* of the settings' false-alarm and missed-detection rates, on the test's
@@ -54,10 +56,13 @@ def gnss_error_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
     errors = support_fix_errors(trace)
     threshold = detectable_bias_m(world)
     steps = {f"support-{s - 1}": int((e > threshold).sum()) for s, e in errors.items()}
+    pooled = [float(v) for e in errors.values() for v in e]
     return {
+        "gnss_multipath": world.scenario.world.gnss.multipath,
         "support_gnss_error_m": {
             f"support-{s - 1}": spread([float(v) for v in e]) for s, e in errors.items()
         },
+        "supports_gnss_error_m": spread(pooled),
         "detectable_bias_m": round(threshold, 4),
         "gnss_error_steps": steps,
         "gnss_error_steps_total": int(sum(steps.values())),

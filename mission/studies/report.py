@@ -47,7 +47,15 @@ INTEGRITY_METRICS = (
     ("integrity.protection.work.integrity_events", "work UAV integrity events"),
     ("integrity.protection.supports.integrity_events", "supports' integrity events"),
 )
+# shown where the multipath came from geometry in some run (issue 47)
+GNSS_METRICS = (
+    ("gnss_error_steps_total", "supports' fixes off by more than the MDB"),
+    ("supports_gnss_error_m.mean", "supports' GNSS error, mean [m]"),
+    ("supports_gnss_error_m.p95", "supports' GNSS error, p95 [m]"),
+    ("supports_gnss_error_m.max", "supports' GNSS error, max [m]"),
+)
 PAIRED = ("completion_time_s", "multipath_steps_total", "work_error_m.mean")
+GEOMETRY_PAIRED = ("completion_time_s", "gnss_error_steps_total", "work_error_m.mean")
 
 
 def write_report(
@@ -63,7 +71,9 @@ def write_report(
     historical study says so in the first line."""
     inspected = any(float(r.get("roles.support_minutes.inspecting") or 0) > 0 for r in rows)
     watched = any(r.get("integrity.exclusions") is not None for r in rows)
+    geometric = _geometric(rows)
     shown = METRICS + (ROLE_METRICS if inspected else ()) + (INTEGRITY_METRICS if watched else ())
+    shown += GNSS_METRICS if geometric else ()
     metrics = tuple(m for m in shown if any(r.get(m[0]) is not None for r in rows))
     figures = write_figures(out_dir / "figures", spec, rows, metrics)
     first = historical_line(provenance)
@@ -83,7 +93,9 @@ def write_report(
         *_means_table(spec, rows, metrics),
     ]
     if set(spec.methods) == {"ac", "nac"}:
-        lines += ["", "## AC against NAC, paired by seed", "", *_paired_table(spec, rows)]
+        paired_columns = GEOMETRY_PAIRED if geometric else PAIRED
+        lines += ["", "## AC against NAC, paired by seed", ""]
+        lines += _paired_table(spec, rows, paired_columns)
         lines += ["", f"p: the {WILCOXON_METHOD}."]
     if figures:
         lines += ["", "## Figures", ""]
@@ -120,16 +132,21 @@ def _means_table(spec: StudySpec, rows: list[dict], metrics) -> list[str]:
     return lines
 
 
-def _paired_table(spec: StudySpec, rows: list[dict]) -> list[str]:
+def _geometric(rows: list[dict]) -> bool:
+    """Whether the multipath came from the structure's geometry in some run."""
+    return any(r.get("gnss_multipath") in ("geometry", "both") for r in rows)
+
+
+def _paired_table(spec: StudySpec, rows: list[dict], columns: tuple[str, ...]) -> list[str]:
     lines = [
         "| scenario | point | pairs | "
-        + " | ".join(f"{label}: AC - NAC [95 % CI] (p)" for label in _paired_labels())
+        + " | ".join(f"{label}: AC - NAC [95 % CI] (p)" for label in _paired_labels(columns))
         + " | NAC fused while in a zone |",
-        "|" + "---|" * (4 + len(PAIRED)),
+        "|" + "---|" * (4 + len(columns)),
     ]
     for scenario, label, mine in _groups(spec, rows):
         cells, pairs = [], 0
-        for column in PAIRED:
+        for column in columns:
             a, n = paired(mine, column)
             pairs = max(pairs, len(a))
             cells.append(_difference_cell(a, n))
@@ -141,9 +158,9 @@ def _paired_table(spec: StudySpec, rows: list[dict]) -> list[str]:
     return lines
 
 
-def _paired_labels() -> list[str]:
-    names = dict(METRICS)
-    return [names[c] for c in PAIRED]
+def _paired_labels(columns: tuple[str, ...]) -> list[str]:
+    names = dict(METRICS + GNSS_METRICS)
+    return [names[c] for c in columns]
 
 
 def _mean_cell(values: list[float]) -> str:

@@ -218,3 +218,34 @@ def test_runs_whose_g_the_study_drops_write_none(tmp_path, monkeypatch):
         for argv in started
     ]
     assert lean == [None, "none", "none"]  # keep all: every snapshot, as a plain run
+
+
+def test_a_geometry_study_reports_gnss_errors_and_pairs_the_steps_over_the_mdb(tmp_path):
+    """Runs whose multipath came from geometry: the report's means carry the supports' GNSS
+    errors, and AC against NAC pairs the fixes off by more than the MDB (here AC's are 5 and
+    NAC's 25 in every pair: -20) instead of the zones' steps."""
+    from mission.studies.report import write_report
+
+    spec = _spec(seeds=(0, 1, 2, 3, 4))
+    rows = []
+    for seed in spec.seeds:
+        for method, off in (("ac", 5), ("nac", 25)):
+            row = {**_summary(StudyRun("along", "along", 0, {}, method, seed, "k"))}
+            row.update(
+                {
+                    "scenario": "along",
+                    "point": 0,
+                    "gnss_multipath": "geometry",
+                    "gnss_error_steps_total": off,
+                    "supports_gnss_error_m.p95": 2.0,
+                    "completion_time_s": row["completion_time_s"],
+                    "work_error_m.mean": 0.1,
+                }
+            )
+            rows.append(row)
+    write_report(tmp_path, spec, rows, 0)
+    report = (tmp_path / "report.md").read_text()
+    assert "supports' GNSS error, p95 [m]" in report
+    assert "supports' fixes off by more than the MDB: AC - NAC" in report
+    assert "| -20.0 (-80.0 %) [-20.0, -20.0]" in report
+    assert "steps in multipath: AC - NAC" not in report
