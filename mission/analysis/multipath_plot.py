@@ -20,6 +20,7 @@ from mission.analysis.figures import save_figure
 from mission.link.plan_files import read_vehicle_waypoints, vehicle_names
 from mission.world.model import World
 from mission.world.multipath import GeometricReceiver, ReceiverSolution
+from mission.world.surfaces import NONE_ABOVE_M, VerticalSurfaces
 
 STEP_M = 0.5  # the slices' resolution
 MAX_HEIGHTS = 3
@@ -52,8 +53,9 @@ def mission_heights(world: World) -> list[float]:
     return sorted(float(h) for h in ranked)
 
 
-def plot_multipath(world: World, path: Path) -> dict[str, float]:
-    """Draw the map to ``path``; returns the worst error found and where."""
+def plot_multipath(world: World, path: Path) -> dict:
+    """Draw the map to ``path``; returns the worst error found and where, and per height
+    the error's spread under the structure and in the open (:func:`region_lines`)."""
     receiver = receiver_of(world)
     heights = mission_heights(world)
     space = world.scenario.world.workspace
@@ -64,6 +66,8 @@ def plot_multipath(world: World, path: Path) -> dict[str, float]:
         len(heights) + 1, 2, figsize=(12, 3.6 * (len(heights) + 1)), squeeze=False
     )
     worst = (-1.0, np.zeros(3))
+    regions = []
+    surfaces = VerticalSurfaces(world.structure)
     for row, z in enumerate(heights):
         points = np.column_stack((grid_x.ravel(), grid_y.ravel(), np.full(grid_x.size, z)))
         inside = world.structure.contains(points)
@@ -74,6 +78,11 @@ def plot_multipath(world: World, path: Path) -> dict[str, float]:
         total = np.where(inside, -1.0, np.nan_to_num(np.hypot(horizontal, vertical), nan=-1))
         if total.max() > worst[0]:
             worst = (float(total.max()), points[int(np.argmax(total))])
+        covered = surfaces.heights(points)[0] < NONE_ABOVE_M
+        outside = ~inside
+        regions.append(
+            (z, _spread(solution, outside & covered), _spread(solution, outside & ~covered))
+        )
         for column, (values, what) in enumerate(
             ((horizontal, "horizontal"), (vertical, "vertical"))
         ):
@@ -89,7 +98,39 @@ def plot_multipath(world: World, path: Path) -> dict[str, float]:
     )
     fig.tight_layout()
     save_figure(fig, path, dpi=100)
-    return {"worst_m": round(worst[0], 3), "x": worst[1][0], "y": worst[1][1], "z": worst[1][2]}
+    where = {"x": worst[1][0], "y": worst[1][1], "z": worst[1][2]}
+    return {"worst_m": round(worst[0], 3), **where, "regions": regions}
+
+
+def _spread(solution: ReceiverSolution, where: np.ndarray) -> dict | None:
+    """Of the points ``where``: the share with a fix, the share not carrier-fixed, and the
+    median, p95 and max of the error where there is a fix."""
+    if not where.any():
+        return None
+    fixed = solution.has_fix & where
+    error = np.linalg.norm(solution.position_error_m[fixed], axis=1)
+    spread = [float(np.percentile(error, q)) for q in (50, 95, 100)] if len(error) else None
+    floating = float((fixed & ~solution.carrier_fixed).sum() / max(int(fixed.sum()), 1))
+    return {"fix": float(fixed.sum() / where.sum()), "float": floating, "error_m": spread}
+
+
+def region_lines(regions: list) -> list[str]:
+    """One line per height and region: under the structure, and in the open."""
+    lines = []
+    for z, *parts in regions:
+        for name, part in zip(("under the structure", "in the open"), parts):
+            if part is None:
+                continue
+            said = (
+                "no fix"
+                if part["error_m"] is None
+                else ("error median {:.2f}, p95 {:.2f}, max {:.2f} m".format(*part["error_m"]))
+            )
+            lines.append(
+                f"  z = {z:g} m, {name}: fix {part['fix']:.0%}, not carrier-fixed "
+                f"{part['float']:.0%}, {said}"
+            )
+    return lines
 
 
 def _slice(ax, world: World, xs, ys, values: np.ndarray, title: str) -> None:

@@ -77,12 +77,14 @@ def world(args: argparse.Namespace) -> int:
         plot_world(world, np.array(point or DEFAULT_PLOT_POINT), args.plot)
         print(f"wrote {args.plot}", file=sys.stderr if point is not None else sys.stdout)
     if args.multipath_map is not None:
-        from mission.analysis.multipath_plot import plot_multipath
+        from mission.analysis.multipath_plot import plot_multipath, region_lines
 
         worst = plot_multipath(world, args.multipath_map)
+        stream = sys.stderr if point is not None else sys.stdout
         print(
             f"wrote {args.multipath_map} (worst error {worst['worst_m']:g} m at "
             f"{worst['x']:g}, {worst['y']:g}, {worst['z']:g})",
-            file=sys.stderr if point is not None else sys.stdout,
+            file=stream,
         )
+        print("\n".join(region_lines(worst["regions"])), file=stream)
     return 0

@@ -105,6 +105,7 @@ def test_the_multipath_map_is_drawn_and_names_its_worst_point(tmp_path, capsys):
     status, out, err = _mission(capsys, "world", "river", "--multipath-map", str(figure))
     assert status == 0, err
     assert "multipath  geometry" in out and f"wrote {figure} (worst error" in out
+    assert "z = 7.5 m, under the structure: fix 100%, not carrier-fixed 100%" in out
     worst = float(out.split("worst error ")[1].split(" m")[0])
     assert 5.0 < worst < 60.0  # under the deck: the published 5-30 m, and a pier's corner
     header = figure.read_bytes()[:24]
