@@ -76,8 +76,12 @@ def raw_file(tmp: Path, text: str) -> Path:
 
 
 def mesh_file(tmp: Path, content: bytes, name: str = "junk.stl") -> Path:
+    """A scenario whose structure is the mesh file ``content`` alone, its multipath from
+    geometry where the name says ``flat`` (a reflecting mesh)."""
     (tmp / name).write_bytes(content)
-    return scenario_file(tmp, f"world: {{structure: {{mesh_file: {name}, primitives: []}}}}\n")
+    reflecting = "zones: [], gnss: {multipath: geometry}, " if name.startswith("flat") else ""
+    structure = f"structure: {{mesh_file: {name}, primitives: []}}"
+    return scenario_file(tmp, f"world: {{{reflecting}{structure}}}\n")
 
 
 def wpl_args(tmp: Path, content: str) -> list[str]:

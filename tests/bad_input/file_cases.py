@@ -53,6 +53,8 @@ LATE_RECALL = "roles: {policy: dynamic, release_clear_s: 3, recall_clear_s: 2}\n
     "[0.0, -16.0, 3.0]",
 )
 
+GEOMETRY = "world: {zones: [], gnss: {multipath: geometry, %s}}\n"
+
 NEW_PATH = "task: {work_waypoints_m: [[-12.0, -3.0, 7.0], [-12.0, 3.0, 7.0]]}\n"
 
 FILE_CASES = [
@@ -364,6 +366,31 @@ FILE_CASES = [
         "mesh-garbage",
         lambda t: [*RUN, str(mesh_file(t, b"\x00\x01not a mesh at all" * 3))],
         ["junk.stl"],
+    ),
+    (
+        "mesh-no-normal",
+        lambda t: [
+            *RUN,
+            str(
+                mesh_file(t, b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n", "flat.obj")
+            ),
+        ],
+        ["bad.yaml", "world.structure.mesh_file", "no normal", "face 1"],
+    ),
+    (
+        "yaml-reflection-coefficient",
+        lambda t: [*RUN, str(scenario_file(t, GEOMETRY % "amplitude: {water: 1.5}"))],
+        ["bad.yaml", "world.gnss.amplitude.water", "[0, 1]"],
+    ),
+    (
+        "yaml-correlator-spacing",
+        lambda t: [*RUN, str(scenario_file(t, GEOMETRY % "correlator_spacing_chips: -0.1"))],
+        ["bad.yaml", "world.gnss.correlator_spacing_chips", "(0, 1]"],
+    ),
+    (
+        "yaml-geometry-with-zones",
+        lambda t: [*RUN, str(scenario_file(t, "world: {gnss: {multipath: geometry}}\n"))],
+        ["bad.yaml", "world.gnss.multipath", "zones: []"],
     ),
     (
         "mesh-no-faces",
