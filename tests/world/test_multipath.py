@@ -256,3 +256,16 @@ def test_the_ground_station_never_gets_the_multipath_model():
     known = world.known()
     assert world.receiver is not None and not hasattr(known, "receiver")
     assert known.scenario.world.gnss.multipath == "zones" and not known.scenario.world.zones
+
+
+def test_a_fix_is_the_same_for_the_same_seed_and_place_one_point_or_many():
+    world = _geometry_world()
+    points = np.array([[-11.0, -6.5, 7.8], [0.0, 0.0, 7.0], [5.0, -7.5, 8.5], [0.0, -19.0, 15.0]])
+    together = world.receiver.solve(points)
+    for k, point in enumerate(points):
+        alone = world.receiver.solve(point[None])
+        assert np.array_equal(alone.position_error_m[0], together.position_error_m[k])
+        assert np.array_equal(alone.range_error_m[0], together.range_error_m[k])
+    first = world.gnss_fix(points[0], np.random.default_rng(11))
+    again = world.gnss_fix(points[0], np.random.default_rng(11))
+    assert np.array_equal(first.position_m, again.position_m) and first.solution == again.solution
