@@ -18,6 +18,7 @@ from mission.config.vehicle_parameters import PARAMETERS, ParameterSpec
 
 REAL32 = mavlink2.MAV_PARAM_TYPE_REAL32
 INT32 = mavlink2.MAV_PARAM_TYPE_INT32
+NUMBER_TYPES = range(mavlink2.MAV_PARAM_TYPE_UINT8, mavlink2.MAV_PARAM_TYPE_REAL64 + 1)
 
 
 @dataclass(frozen=True)
@@ -66,10 +67,13 @@ class ParameterTable:
 
     def refusal(self, index: int, value: float, kind: int) -> str | None:
         """Why ``value`` (sent as MAV_PARAM_TYPE ``kind``) cannot be set at ``index``; None if
-        it can."""
+        it can. As ArduPilot, any number type is taken and the value converted (C-cast): an
+        integer parameter takes an integral value sent as REAL32, which pymavlink's
+        ``mavset`` and a MAVProxy without a fetched list send; the value's own checks (whole,
+        in range) still hold."""
         parameter = self._parameters[index]
-        if parameter.spec.read_only is None and kind != parameter.kind:
-            return f"is of type {parameter.kind}, not {kind}"
+        if parameter.spec.read_only is None and kind not in NUMBER_TYPES:
+            return f"param type {kind} unknown"
         return parameter.spec.refusal(value)
 
     def set(self, index: int, value: float) -> None:

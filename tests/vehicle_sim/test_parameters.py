@@ -81,9 +81,10 @@ def test_a_set_is_echoed_and_kept(client):
         ("SIM_SPEEDUP", 10.0, mavlink2.MAV_PARAM_TYPE_REAL32, "the run's clock"),
         ("FS_GCS_TIMEOUT", math.nan, mavlink2.MAV_PARAM_TYPE_REAL32, "finite"),
         ("FS_GCS_TIMEOUT", 1e6, mavlink2.MAV_PARAM_TYPE_REAL32, "must be in"),
-        ("FS_GCS_TIMEOUT", 5.0, mavlink2.MAV_PARAM_TYPE_INT32, "type"),
+        ("FS_GCS_TIMEOUT", 5.0, 0, "param type 0 unknown"),
+        ("SIM_GPS1_ENABLE", 0.5, mavlink2.MAV_PARAM_TYPE_REAL32, "whole number"),
     ],
-    ids=["read-only", "nan", "out-of-range", "wrong-type"],
+    ids=["read-only", "nan", "out-of-range", "no-type", "integer-not-whole"],
 )
 def test_a_refused_set_is_echoed_unchanged_and_said_why(client, name, value, kind, reason):
     before = _read(client, name).param_value
@@ -91,6 +92,38 @@ def test_a_refused_set_is_echoed_unchanged_and_said_why(client, name, value, kin
     assert echo is not None and echo.param_value == before
     said = _said(client, name)
     assert said and reason in said[-1], said
+
+
+@pytest.mark.parametrize("kind", range(1, 11), ids=lambda k: f"type-{k}")
+def test_any_number_type_sets_an_integer_and_a_float_parameter(client, kind):
+    """As ArduPilot: the PARAM_SET's type is not the parameter's to match; its value (C-cast)
+    is converted. Each MAV_PARAM_TYPE sets SIM_GPS1_ENABLE (INT32) and FS_GCS_TIMEOUT
+    (REAL32), and the echo keeps the parameter's own type."""
+    for name, value, other in (("SIM_GPS1_ENABLE", 0.0, 1.0), ("FS_GCS_TIMEOUT", 9.0, 5.0)):
+        echo = _set(client, name, value, kind)
+        assert echo is not None and echo.param_value == value, _said(client, name)
+        expected = _read(client, name).param_type
+        assert echo.param_type == expected
+        assert _set(client, name, other, kind).param_value == other
+
+
+def test_pymavlinks_mavset_sets_an_integer_parameter_as_real32(vehicle):
+    """``mavparm.MAVParmDict().mavset`` with its default type (REAL32), as ``param set
+    SIM_GPS1_ENABLE 0`` from a MAVProxy that has not fetched the list sends it."""
+    from pymavlink import mavparm, mavutil
+
+    address = "udpout:{}:{}".format(*vehicle.address)
+    master = mavutil.mavlink_connection(address, source_system=255, dialect="ardupilotmega")
+    try:
+        master.mav.heartbeat_send(6, 8, 0, 0, 0)
+        master.target_system = SYSID
+        assert mavparm.MAVParmDict().mavset(master, "SIM_GPS1_ENABLE", 0, retries=3)
+        master.param_fetch_one("SIM_GPS1_ENABLE")
+        value = master.recv_match(type="PARAM_VALUE", blocking=True, timeout=2.0)
+        assert value is not None and value.param_value == 0.0
+        master.param_set_send("SIM_GPS1_ENABLE", 1.0)
+    finally:
+        master.close()
 
 
 def test_an_unknown_id_is_said_and_gets_no_value(client):
