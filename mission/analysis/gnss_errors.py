@@ -40,14 +40,20 @@ def detectable_bias_m(world: World) -> float:
     return float(np.sqrt(detectable * np.linalg.eigvalsh(covariance)[0]))
 
 
+def fixes_and_truth(trace: RunTrace, system: int) -> tuple[np.ndarray, np.ndarray]:
+    """(fixes, truth there) of one vehicle's 3-D fixes whose truth is known, each (n, 3)."""
+    times = sorted(t for s, t in trace.fixes if s == system)
+    truth, known = trace.truth_at(system, times)
+    fixes = np.array([trace.fixes[(system, t)] for t in times]).reshape(-1, 3)
+    return fixes[known], truth[known]
+
+
 def support_fix_errors(trace: RunTrace) -> dict[int, np.ndarray]:
     """Per support system id, |fix - truth| of each 3-D fix whose truth is known."""
     errors = {}
     for system in trace.supports:
-        times = sorted(t for s, t in trace.fixes if s == system)
-        truth, known = trace.truth_at(system, times)
-        fixes = np.array([trace.fixes[(system, t)] for t in times]).reshape(-1, 3)
-        errors[system] = np.linalg.norm(fixes[known] - truth[known], axis=1)
+        fixes, truth = fixes_and_truth(trace, system)
+        errors[system] = np.linalg.norm(fixes - truth, axis=1)
     return errors
 
 

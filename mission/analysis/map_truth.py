@@ -1,6 +1,6 @@
 """Does G learn the right places? (issue 47) A run's final map against the true error field
 that multipath from geometry makes (the receiver's fix error without noise at each voxel's
-centre; a voxel without a fix counts as the worst).
+centre; a voxel without a fix counts as the worst, one inside the structure not at all).
 
 Compared over the voxels the run taught G something (G moved from sigma_0 by more than
 ``LEARNED_M``: where the supports flew): the rank correlation (Spearman) of G with the field,
@@ -23,25 +23,29 @@ TOP_SHARE = 0.1
 
 def error_field(world: World) -> np.ndarray:
     """|fix error| (no noise) at every voxel centre of G's grid, in its shape; +inf where a
-    receiver there has no fix."""
+    receiver there has no fix, NaN inside the structure (compared nowhere)."""
     grid = world.map_grid()
-    solution = world.receiver.solve(grid.centers().reshape(-1, 3))
+    centres = grid.centers().reshape(-1, 3)
+    solution = world.receiver.solve(centres)
     error = np.linalg.norm(solution.position_error_m, axis=1)
-    return np.where(np.isnan(error), np.inf, error).reshape(grid.shape)
+    error = np.where(np.isnan(error), np.inf, error)
+    return np.where(world.structure.contains(centres), np.nan, error).reshape(grid.shape)
 
 
 def map_against_field(initial: np.ndarray, final: np.ndarray, field: np.ndarray) -> dict:
     """G's and the prior's agreement with ``field`` over the learned voxels."""
     from scipy.stats import spearmanr
 
-    learned = np.abs(final - initial).reshape(-1) > LEARNED_M
+    learned = (np.abs(final - initial) > LEARNED_M).reshape(-1) & ~np.isnan(field.reshape(-1))
     truth = field.reshape(-1)[learned]
     result: dict = {"learned_voxels": int(learned.sum())}
+    finite = truth[np.isfinite(truth)]
+    varied = len(finite) >= 2 and np.ptp(finite) > 0
     for name, values in (
         ("G", final.reshape(-1)[learned]),
         ("prior", initial.reshape(-1)[learned]),
     ):
-        enough = len(truth) >= 10 and np.ptp(values) > 0 and np.ptp(truth[np.isfinite(truth)]) > 0
+        enough = varied and len(truth) >= 10 and np.ptp(values) > 0
         rho = float(spearmanr(values, truth).statistic) if enough else None
         precision, recall = top_overlap(values, truth) if enough else (None, None)
         result[name] = {

@@ -59,12 +59,10 @@ def bench_multipath(repeats: int = 3) -> list[BenchResult]:
 
 def _fix_positions(trace) -> np.ndarray:
     """The true position of every vehicle at every fix it reported."""
-    rows = []
-    for system in sorted({s for s, _ in trace.fixes}):
-        times = sorted(t for s, t in trace.fixes if s == system)
-        truth, known = trace.truth_at(system, times)
-        rows.append(truth[known])
-    return np.vstack(rows)
+    from mission.analysis.gnss_errors import fixes_and_truth
+
+    systems = sorted({s for s, _ in trace.fixes})
+    return np.vstack([fixes_and_truth(trace, system)[1] for system in systems])
 
 
 def _time_fixes(worlds: dict, positions: np.ndarray, first: str) -> dict[str, float]:

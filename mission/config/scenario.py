@@ -18,6 +18,7 @@ from mission.config.errors import FieldProblem, ScenarioError, read_text_file
 from mission.config.resources import check_resources
 from mission.config.settings import Scenario
 from mission.config.settings_build import build_settings
+from mission.config.signal_settings import SignalSettings
 
 DEFAULTS_NAME = "defaults"
 _MAX_EXTENDS_DEPTH = 8
@@ -33,6 +34,13 @@ def embedded_scenario_names() -> list[str]:
     return sorted(
         p.stem for p in embedded_scenarios_dir().glob("*.yaml") if p.stem != DEFAULTS_NAME
     )
+
+
+def default_signal_settings() -> SignalSettings:
+    """``world.gnss`` as defaults.yaml has it: what a scenario says of multipath when it says
+    nothing (the ground station's scenario carries these, never a run's own)."""
+    data = read_yaml_mapping(embedded_scenarios_dir() / f"{DEFAULTS_NAME}.yaml")
+    return build_settings(SignalSettings, data["world"]["gnss"], "world.gnss")
 
 
 def resolve_scenario_path(name_or_path: str) -> Path:

@@ -2,7 +2,7 @@
 the constants of reflections and code tracking (:mod:`mission.world.multipath`).
 
 These belong to the simulated world only: the ground station's scenario carries the defaults
-(:func:`mission.world.model.without_zones`), never the model a run's vehicles use.
+(:func:`mission.world.model.without_multipath`), never the model a run's vehicles use.
 """
 
 from __future__ import annotations

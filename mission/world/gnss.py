@@ -133,9 +133,7 @@ class GnssModel:
         return has_fix[index], cov[index]
 
     def _covariance(self, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return _covariance_from_visibility(
-            visible, self._rows, self.sky.constellation_index(), len(self.sky.constellations)
-        )
+        return _covariance_from_visibility(visible, self._rows, self.sky.constellation_index())
 
     def _geometry_chunk(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         geometry = self.geometry_from_visibility(self.visibility(points))
@@ -167,21 +165,8 @@ class GnssModel:
         visible = self.visibility(point[None])[0]
         n_visible = int(visible.sum())
         cov_geom, factor = self._fix_geometry(visible)
-        if cov_geom is None or factor is None:
-            return GnssFix(False, None, None, n_visible, None, None)
         sigma = self.settings.sigma_uere_m if sigma_uere_m is None else sigma_uere_m
-        covariance = sigma**2 * cov_geom
-        noise = sigma * (factor @ rng.standard_normal(3))
-        offset = np.zeros(3) if offset_m is None else np.asarray(offset_m, dtype=float)
-        hdop = float(np.sqrt(cov_geom[0, 0] + cov_geom[1, 1]))
-        return GnssFix(
-            True,
-            point + noise + offset,
-            covariance,
-            n_visible,
-            hdop,
-            float(np.sqrt(cov_geom[2, 2])),
-        )
+        return noisy_fix(point, cov_geom, factor, n_visible, rng, sigma, offset_m)
 
     def _fix_geometry(self, visible: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
         """cov_geom and its Cholesky factor for a visibility mask (None without a fix),
@@ -192,7 +177,7 @@ class GnssModel:
             cov_geom = _single_point_cov_geom(
                 self._rows[visible], self.sky.constellation_index()[visible]
             )
-            factor = _cholesky_or_none(cov_geom) if cov_geom is not None else None
+            factor = cholesky_or_none(cov_geom) if cov_geom is not None else None
             if len(self._fix_geometry_by_mask) >= _MAX_REMEMBERED_MASKS:
                 self._fix_geometry_by_mask.clear()
             known = self._fix_geometry_by_mask[key] = (cov_geom, factor)
@@ -212,6 +197,72 @@ class GnssFix:
     solution: str = "rtk-fixed"  # or "rtk-float" / "code" (multipath from geometry)
 
 
+def cholesky_or_none(matrix: np.ndarray) -> np.ndarray | None:
+    """Lower Cholesky factor, or None when the matrix is not positive definite (no fix)."""
+    try:
+        factor = np.linalg.cholesky(matrix)
+    except np.linalg.LinAlgError:
+        return None
+    return factor if np.all(np.isfinite(factor)) else None
+
+
+def noisy_fix(
+    solved: np.ndarray,
+    cov_geom: np.ndarray | None,
+    factor: np.ndarray | None,
+    n_used: int,
+    rng: np.random.Generator,
+    sigma: float,
+    offset_m: np.ndarray | None = None,
+    solution: str = "rtk-fixed",
+) -> GnssFix:
+    """A receiver's fix: ``solved`` (the truth, or the truth and the geometry's bias) +
+    sigma ``factor`` z (z three standard normals drawn from ``rng``) + ``offset_m`` (a
+    zone's); no fix (and no draw) without a geometry. Accuracy from ``cov_geom`` alone."""
+    if cov_geom is None or factor is None:
+        return GnssFix(False, None, None, n_used, None, None)
+    noise = sigma * (factor @ rng.standard_normal(3))
+    offset = np.zeros(3) if offset_m is None else np.asarray(offset_m, dtype=float)
+    return GnssFix(
+        True,
+        solved + noise + offset,
+        sigma**2 * cov_geom,
+        n_used,
+        float(np.sqrt(cov_geom[0, 0] + cov_geom[1, 1])),
+        float(np.sqrt(cov_geom[2, 2])),
+        solution,
+    )
+
+
+def least_squares_fix(
+    rows: np.ndarray, system: np.ndarray, weight: np.ndarray, error: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The weighted least-squares fix of N receivers from pseudorange errors ``error`` (N, S)
+    with ``weight`` (N, S; 0: not used): (has_fix (N,), position error (N, 3), cov_geom
+    (N, 3, 3)), NaN without a fix. ``rows``: H's rows (S, 3 + C), [-e^T, one-hot clock];
+    ``system``: each satellite's constellation (S,). A clock no used satellite observes is no
+    unknown (a unit diagonal decouples its column); no fix from fewer satellites than
+    unknowns or a singular geometry."""
+    used = weight > 0
+    n_systems = rows.shape[1] - 3
+    normal = np.einsum("ns,si,sj->nij", weight, rows, rows)
+    per_system = np.stack([used[:, system == k].sum(axis=1) for k in range(n_systems)], axis=1)
+    unused = per_system == 0
+    for k in range(n_systems):
+        normal[unused[:, k], 3 + k, 3 + k] = 1.0
+    unknowns = 3 + (~unused).sum(axis=1)
+    enough = used.sum(axis=1) >= unknowns
+    has_fix = enough & (np.linalg.eigvalsh(normal)[:, 0] > _MIN_EIGENVALUE)
+    position_error = np.full((len(used), 3), np.nan)
+    cov = np.full((len(used), 3, 3), np.nan)
+    if np.any(has_fix):
+        inverse = np.linalg.inv(normal[has_fix])
+        rhs = np.einsum("ns,si,ns->ni", weight[has_fix], rows, error[has_fix])
+        position_error[has_fix] = np.einsum("nij,nj->ni", inverse, rhs)[:, :3]
+        cov[has_fix] = inverse[:, :3, :3]
+    return has_fix, position_error, cov
+
+
 def _geometry_rows(directions: np.ndarray, system: np.ndarray, n_systems: int) -> np.ndarray:
     """Rows of H for every satellite: [-e^T, one-hot receiver clock of its constellation]."""
     clock = np.zeros((len(directions), n_systems))
@@ -220,23 +271,11 @@ def _geometry_rows(directions: np.ndarray, system: np.ndarray, n_systems: int) -
 
 
 def _covariance_from_visibility(
-    visible: np.ndarray, rows: np.ndarray, system: np.ndarray, n_systems: int
+    visible: np.ndarray, rows: np.ndarray, system: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     visible = np.asarray(visible, dtype=bool)
-    weights = visible.astype(float)
-    normal = np.einsum("ns,si,sj->nij", weights, rows, rows)
-    per_system = np.stack([visible[:, system == k].sum(axis=1) for k in range(n_systems)], axis=1)
-    unused = per_system == 0
-    # A clock no satellite observes is not estimated: a unit diagonal decouples its column.
-    for k in range(n_systems):
-        normal[unused[:, k], 3 + k, 3 + k] = 1.0
-    unknowns = 3 + (~unused).sum(axis=1)
-    enough = visible.sum(axis=1) >= unknowns
-    eigen_min = np.linalg.eigvalsh(normal)[:, 0]
-    has_fix = enough & (eigen_min > _MIN_EIGENVALUE)
-    cov = np.full((len(visible), 3, 3), np.nan)
-    if np.any(has_fix):
-        cov[has_fix] = np.linalg.inv(normal[has_fix])[:, :3, :3]
+    weight = visible.astype(float)
+    has_fix, _, cov = least_squares_fix(rows, system, weight, np.zeros_like(weight))
     return has_fix, cov
 
 
@@ -255,12 +294,3 @@ def _single_point_cov_geom(rows: np.ndarray, system: np.ndarray) -> np.ndarray |
     if np.linalg.eigvalsh(normal)[0] <= _MIN_EIGENVALUE:  # the batched path's rule
         return None
     return np.linalg.inv(normal)[:3, :3]
-
-
-def _cholesky_or_none(matrix: np.ndarray) -> np.ndarray | None:
-    """Lower Cholesky factor, or None when the matrix is not positive definite (no fix)."""
-    try:
-        factor = np.linalg.cholesky(matrix)
-    except np.linalg.LinAlgError:
-        return None
-    return factor if np.all(np.isfinite(factor)) else None

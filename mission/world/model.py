@@ -16,7 +16,7 @@ from typing import Self
 
 import numpy as np
 
-from mission.config.scenario import load_scenario
+from mission.config.scenario import default_signal_settings, load_scenario
 from mission.config.settings import Scenario
 from mission.world.camera import CameraModel
 from mission.world.gnss import GnssFix, GnssModel
@@ -48,7 +48,7 @@ class KnownWorld:
     def __init__(self, scenario: Scenario, structure: Structure | None = None) -> None:
         """Build it for ``scenario`` (whose zones are left out); ``structure``: the scenario's
         structure if already built."""
-        self.scenario = without_zones(scenario)
+        self.scenario = without_multipath(scenario)
         if structure is None:
             structure = build_structure(scenario.world.structure, scenario.source)
         self.structure = structure
@@ -145,7 +145,7 @@ class World(KnownWorld):
         return self.receiver.sample_fix(truth, rng, offset, sigma_uere_m, multipath_scale)
 
     def known(self) -> KnownWorld:
-        """This world without its zones (the same structure)."""
+        """This world without its multipath model (the same structure)."""
         return KnownWorld(self.scenario, self.structure)
 
     def in_zone(self, points: np.ndarray) -> np.ndarray:
@@ -157,11 +157,12 @@ class World(KnownWorld):
         return self.zones.offset(points)
 
 
-def without_zones(scenario: Scenario) -> Scenario:
-    """The scenario with no multipath model: no zones, and ``world.gnss.multipath`` at
-    ``zones`` (none of them), everything else the same."""
+def without_multipath(scenario: Scenario) -> Scenario:
+    """The scenario with no multipath model: no zones, and ``world.gnss`` as the defaults
+    have it (zones, of which there are none; the default surfaces and receiver), whatever
+    the scenario's own; everything else the same."""
     world = scenario.world
-    if not world.zones and world.gnss.multipath == "zones":
+    gnss = default_signal_settings()
+    if not world.zones and world.gnss == gnss:
         return scenario
-    gnss = dataclasses.replace(world.gnss, multipath="zones")
     return dataclasses.replace(scenario, world=dataclasses.replace(world, zones=[], gnss=gnss))

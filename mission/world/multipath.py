@@ -32,11 +32,16 @@ import numpy as np
 
 from mission.config.signal_settings import SignalSettings
 from mission.world.code_tracking import chip_length_m, echo_error_chips
-from mission.world.gnss import GnssFix, GnssModel
+from mission.world.gnss import (
+    GnssFix,
+    GnssModel,
+    cholesky_or_none,
+    least_squares_fix,
+    noisy_fix,
+)
 from mission.world.reflections import ReflectedPaths, Reflectors
 
-_MIN_EIGENVALUE = 1e-9  # GnssModel's rule for a usable geometry
-_FALLBACK = {"rtk": "rtk-float", "code": "code"}  # what a fix is when not carrier-fixed
+_UNFIXED_SOLUTION = {"rtk": "rtk-float", "code": "code"}  # a fix not carrier-fixed
 
 
 @dataclass(frozen=True)
@@ -111,7 +116,7 @@ class GeometricReceiver:
             ),
         )
         cn0 = np.where(direct, self.signal.cn0_open_sky_dbhz, np.nan)
-        reflected = self._strongest_reflections(paths, ~direct, error, cn0)
+        reflected, error, cn0 = self._strongest_reflections(paths, ~direct, error, cn0)
         tracked = np.isfinite(cn0) & (cn0 >= self.signal.cn0_floor_dbhz)
         reflected &= tracked
         error = np.where(tracked, error, 0.0)
@@ -132,9 +137,11 @@ class GeometricReceiver:
 
     def _strongest_reflections(
         self, paths: ReflectedPaths, blocked: np.ndarray, error: np.ndarray, cn0: np.ndarray
-    ) -> np.ndarray:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Where the direct signal is blocked, track the strongest reflection (the shorter on
-        a tie): its excess path into ``error``, its C/N0 into ``cn0`` (both in place)."""
+        a tie): (where one is tracked, ``error`` with its excess path there, ``cn0`` with its
+        C/N0 there)."""
+        error, cn0 = error.copy(), cn0.copy()
         nlos = blocked[paths.point, paths.satellite] & (paths.amplitude > 0)
         point, sat = paths.point[nlos], paths.satellite[nlos]
         amplitude, excess = paths.amplitude[nlos], paths.excess_m[nlos]
@@ -147,7 +154,7 @@ class GeometricReceiver:
         cn0[point, sat] = self.signal.cn0_open_sky_dbhz + 20 * np.log10(amplitude[first])
         reflected = np.zeros_like(blocked)
         reflected[point, sat] = True
-        return reflected
+        return reflected, error, cn0
 
     def sample_fix(
         self,
@@ -163,51 +170,10 @@ class GeometricReceiver:
         point = np.asarray(point, dtype=float).reshape(3)
         solution = self.solve(point[None])
         n_used = int(solution.n_used[0])
-        if not solution.has_fix[0]:
-            return GnssFix(False, None, None, n_used, None, None)
-        cov_geom = solution.cov_geom[0]
-        try:
-            factor = np.linalg.cholesky(cov_geom)
-        except np.linalg.LinAlgError:
-            return GnssFix(False, None, None, n_used, None, None)
+        cov_geom = solution.cov_geom[0] if solution.has_fix[0] else None
+        factor = cholesky_or_none(cov_geom) if cov_geom is not None else None
         sigma = self.gnss.settings.sigma_uere_m if sigma_uere_m is None else sigma_uere_m
-        noise = sigma * (factor @ rng.standard_normal(3))
-        offset = np.zeros(3) if offset_m is None else np.asarray(offset_m, dtype=float)
-        position = point + scale * solution.position_error_m[0] + noise + offset
-        return GnssFix(
-            True,
-            position,
-            sigma**2 * cov_geom,
-            n_used,
-            float(np.sqrt(cov_geom[0, 0] + cov_geom[1, 1])),
-            float(np.sqrt(cov_geom[2, 2])),
-            solution="rtk-fixed" if solution.carrier_fixed[0] else _FALLBACK[self.signal.solution],
-        )
-
-
-def least_squares_fix(
-    rows: np.ndarray, system: np.ndarray, weight: np.ndarray, error: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The weighted least-squares fix of N receivers from pseudorange errors ``error`` (N, S)
-    with ``weight`` (N, S; 0: not used): (has_fix (N,), position error (N, 3), cov_geom
-    (N, 3, 3)), NaN without a fix. ``rows``: H's rows (S, 3 + C), [-e^T, one-hot clock];
-    ``system``: each satellite's constellation (S,); a clock no used satellite observes is not
-    an unknown (GnssModel's rule)."""
-    used = weight > 0
-    n_systems = rows.shape[1] - 3
-    normal = np.einsum("ns,si,sj->nij", weight, rows, rows)
-    rhs = np.einsum("ns,si,ns->ni", weight, rows, error)
-    per_system = np.stack([used[:, system == k].sum(axis=1) for k in range(n_systems)], axis=1)
-    unused = per_system == 0
-    for k in range(n_systems):  # a unit diagonal decouples an unobserved clock's column
-        normal[unused[:, k], 3 + k, 3 + k] = 1.0
-    unknowns = 3 + (~unused).sum(axis=1)
-    has_fix = used.sum(axis=1) >= unknowns
-    has_fix &= np.linalg.eigvalsh(normal)[:, 0] > _MIN_EIGENVALUE
-    position_error = np.full((len(used), 3), np.nan)
-    cov = np.full((len(used), 3, 3), np.nan)
-    if np.any(has_fix):
-        inverse = np.linalg.inv(normal[has_fix])
-        position_error[has_fix] = np.einsum("nij,nj->ni", inverse, rhs[has_fix])[:, :3]
-        cov[has_fix] = inverse[:, :3, :3]
-    return has_fix, position_error, cov
+        fixed = bool(solution.carrier_fixed[0]) or scale == 0  # no bias left to float on
+        kind = "rtk-fixed" if fixed else _UNFIXED_SOLUTION[self.signal.solution]
+        bias = scale * solution.position_error_m[0] if solution.has_fix[0] else 0.0
+        return noisy_fix(point + bias, cov_geom, factor, n_used, rng, sigma, offset_m, kind)

@@ -29,10 +29,11 @@ from mission.config.errors import ScenarioError
 from mission.world.structure import Structure
 
 LIFT_M = 1e-3  # legs start this far off a face, on its lit side, so that it does not block them
-_MIN_HEIGHT_M = 1e-6  # a receiver on a plane sees no reflection off it
+_MIN_HEIGHT_M = 10 * LIFT_M  # a receiver this close to a plane sees no reflection off it
 _INSIDE_TOLERANCE = 1e-9  # barycentric slack: a point on a triangle's edge is on it
 _MIN_AREA_M2 = 1e-12
 _CHUNK_CANDIDATES = 400_000  # (point, satellite, plane, triangle) tuples at a time
+MAX_PLANE_TRIANGLES = 16  # a reflecting plane's triangles tested at once
 _SKY_M = 1.0e6  # a leg to a satellite: far beyond any structure
 
 
@@ -97,7 +98,9 @@ class Reflectors:
         cos = cosine[i, s, g]
         normal = side[i, g, None] * self.normals[g]
         specular = points[i] + (h / cos)[:, None] * self.directions[s] - (2 * h)[:, None] * normal
-        on = (g == self.ground) | self._triangles.hold(specular, g)
+        on = g == self.ground
+        faced = ~on
+        on[faced] = self._triangles.contain(specular[faced], g[faced])
         i, s, g, h, cos, normal, specular = (a[on] for a in (i, s, g, h, cos, normal, specular))
         lifted = specular + LIFT_M * normal
         open_legs = ~self._legs_blocked(points[i], lifted, self.directions[s])
@@ -145,7 +148,7 @@ class _PaddedTriangles:
         self.valid = denominator > 0
         self.inverse = np.where(self.valid, 1.0 / np.where(self.valid, denominator, 1.0), 0.0)
 
-    def hold(self, points: np.ndarray, plane: np.ndarray) -> np.ndarray:
+    def contain(self, points: np.ndarray, plane: np.ndarray) -> np.ndarray:
         """Whether each point (on its plane) lies on one of that plane's triangles."""
         offset = points[:, None, :] - self.v0[plane]  # (K, T, 3)
         d20 = np.einsum("ktj,ktj->kt", offset, self.e1[plane])
@@ -155,6 +158,22 @@ class _PaddedTriangles:
         inside = (v >= -_INSIDE_TOLERANCE) & (w >= -_INSIDE_TOLERANCE)
         inside &= (v + w <= 1 + _INSIDE_TOLERANCE) & self.valid[plane]
         return inside.any(axis=1)
+
+
+def _split_wide(plane_of: np.ndarray) -> np.ndarray:
+    """Plane numbers with no plane of more than MAX_PLANE_TRIANGLES triangles: a wide one
+    (a finely meshed deck) becomes several of the same plane, so that the point-on-face test
+    stays small (a specular point on an edge between two of them may then count twice)."""
+    if len(plane_of) == 0:
+        return plane_of
+    order = np.argsort(plane_of, kind="stable")
+    sorted_planes = plane_of[order]
+    starts = np.searchsorted(sorted_planes, sorted_planes)  # each triangle's plane's first
+    part = (np.arange(len(order)) - starts) // MAX_PLANE_TRIANGLES
+    _, split = np.unique(np.column_stack((sorted_planes, part)), axis=0, return_inverse=True)
+    result = np.empty_like(plane_of)
+    result[order] = split.reshape(-1)
+    return result
 
 
 def check_reflecting_faces(structure: Structure, source: str = "") -> None:
@@ -188,16 +207,16 @@ def _planes(
             f"{int(flat[0])}): a reflecting surface needs one; remove them from the mesh",
         )
     normal = cross / doubled_area[:, None]
-    leading = np.argmax(np.abs(normal) > 1e-9, axis=1)
-    normal *= np.sign(normal[np.arange(len(normal)), leading])[:, None]
+    largest = np.argmax(np.abs(normal), axis=1)  # its sign decides: robust to float noise
+    normal *= np.sign(normal[np.arange(len(normal)), largest])[:, None]
     offset = np.einsum("ij,ij->i", normal, corners[:, 0])
     # triangles on the ground's plane (a pier's footing) are the ground's to reflect
     kept = np.flatnonzero(~((np.abs(normal[:, 2] - 1) < 1e-9) & (np.abs(offset) < 1e-4)))
     key = np.column_stack((np.round(normal[kept], 6), np.round(offset[kept], 4)))
-    unique, plane_of = np.unique(key.reshape(-1, 4), axis=0, return_inverse=True)
-    plane_of = plane_of.reshape(-1)
+    _, plane_of = np.unique(key.reshape(-1, 4), axis=0, return_inverse=True)
+    plane_of = _split_wide(plane_of.reshape(-1))
     ranked = np.argsort(plane_of, kind="stable")
     order = kept[ranked]
-    starts = np.searchsorted(plane_of[ranked], np.arange(len(unique) + 1))
+    starts = np.searchsorted(plane_of[ranked], np.arange(plane_of.max(initial=-1) + 2))
     first = order[starts[:-1]]
     return normal[first].reshape(-1, 3), offset[first], order, starts

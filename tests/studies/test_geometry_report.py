@@ -79,3 +79,16 @@ def test_a_study_without_geometry_has_no_map_rows(tmp_path, monkeypatch):
         "scenario,point,method,seed,run_key\nalong,0,ac,0,abcdefabcdef\n"
     )
     assert geometry_report.map_table(study, out).count("\n") == 1  # the header alone
+
+
+def test_voxels_inside_the_structure_are_not_compared_and_no_fix_anywhere_is_no_answer():
+    field = np.arange(60.0).reshape(3, 4, 5)
+    initial = np.zeros(field.shape)
+    final = field / 100 + 0.5
+    inside = field.copy()
+    inside[0] = np.nan  # a slab inside the structure
+    result = map_against_field(initial, final, inside)
+    assert result["learned_voxels"] == 40
+    assert result["G"]["spearman"] == 1.0
+    blind = map_against_field(initial, final, np.full(field.shape, np.inf))
+    assert blind["G"] == {"spearman": None, "precision": None, "recall": None}

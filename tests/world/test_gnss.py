@@ -181,7 +181,7 @@ def test_fixes_are_the_same_with_remembered_geometry(along_world, monkeypatch):
         cov = gnss._single_point_cov_geom(
             model._rows[visible], model.sky.constellation_index()[visible]
         )
-        return cov, gnss._cholesky_or_none(cov) if cov is not None else None
+        return cov, gnss.cholesky_or_none(cov) if cov is not None else None
 
     monkeypatch.setattr(fresh, "_fix_geometry", lambda visible: afresh(fresh, visible))
     rng_a, rng_b = np.random.default_rng(9), np.random.default_rng(9)
@@ -202,9 +202,7 @@ def _every_row_computed(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarr
     from mission.world import gnss
 
     visible = model.visibility(points)
-    return gnss._covariance_from_visibility(
-        visible, model._rows, model.sky.constellation_index(), len(model.sky.constellations)
-    )
+    return gnss._covariance_from_visibility(visible, model._rows, model.sky.constellation_index())
 
 
 def test_a_few_points_geometry_equals_the_batched_computation(along_world, monkeypatch):

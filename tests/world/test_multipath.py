@@ -13,8 +13,8 @@ from mission.config.errors import ScenarioError
 from mission.config.scenario import load_scenario
 from mission.config.settings import BoxPrimitive, StructureSettings
 from mission.world.code_tracking import discriminator, echo_error_chips
+from mission.world.gnss import least_squares_fix
 from mission.world.model import World
-from mission.world.multipath import least_squares_fix
 from mission.world.reflections import Reflectors, check_reflecting_faces
 from mission.world.structure import Structure, build_structure
 
@@ -252,10 +252,16 @@ def test_bad_signal_settings_are_refused_naming_the_field(override, field):
 
 
 def test_the_ground_station_never_gets_the_multipath_model():
-    world = World(load_scenario("river"))
+    """Not the model, nor what would rebuild it: the river's water, its receiver, its
+    constants are the defaults' in the known world's scenario."""
+    river = load_scenario(
+        "river", {"world.gnss.amplitude.concrete": 0.3, "world.gnss.solution": "code"}
+    )
+    world = World(river)
     known = world.known()
     assert world.receiver is not None and not hasattr(known, "receiver")
-    assert known.scenario.world.gnss.multipath == "zones" and not known.scenario.world.zones
+    assert known.scenario.world.gnss == load_scenario("along").world.gnss  # the defaults
+    assert known.scenario.world.gnss.ground_surface == "ground" and not known.scenario.world.zones
 
 
 def test_a_fix_is_the_same_for_the_same_seed_and_place_one_point_or_many():
@@ -269,3 +275,29 @@ def test_a_fix_is_the_same_for_the_same_seed_and_place_one_point_or_many():
     first = world.gnss_fix(points[0], np.random.default_rng(11))
     again = world.gnss_fix(points[0], np.random.default_rng(11))
     assert np.array_equal(first.position_m, again.position_m) and first.solution == again.solution
+
+
+def test_a_finely_meshed_wall_reflects_as_one_face():
+    """A 20 m x 20 m wall at x = 0 of 800 triangles, split into planes of at most 16 for the
+    face test: each satellite on its lit side reflects once, 2 d cos e cos dAz later."""
+    n = 20
+    y, z = np.meshgrid(np.linspace(-10, 10, n + 1), np.linspace(0, 20, n + 1), indexing="ij")
+    vertices = np.column_stack((np.zeros(y.size), y.ravel(), z.ravel()))
+    index = np.arange(y.size).reshape(n + 1, n + 1)
+    quads = [(index[i, j], index[i + 1, j], index[i + 1, j + 1], index[i, j + 1])
+             for i in range(n) for j in range(n)]  # fmt: skip
+    faces = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+    structure = Structure(vertices, faces, [])
+    directions = _directions(np.random.default_rng(5), 40)
+    reflectors = Reflectors(structure, directions, 0.5, 0.0, 0.0)
+    assert len(reflectors.normals) - 1 == 800 // 16  # the wall in planes of 16, and the ground
+    point = np.array([[3.0, 0.3, 7.1]])
+    paths = reflectors.paths(point)
+    wall = paths.plane != reflectors.ground
+    sats = paths.satellite[wall]
+    assert len(sats) == len(set(sats))  # once each
+    reach = 3.0 / directions[:, 0]
+    on = (directions[:, 0] > 0) & (np.abs(0.3 + reach * directions[:, 1]) <= 10)
+    on &= (7.1 + reach * directions[:, 2] >= 0) & (7.1 + reach * directions[:, 2] <= 20)
+    assert set(sats) == set(np.flatnonzero(on))
+    assert np.allclose(paths.excess_m[wall], 2 * 3.0 * directions[sats, 0], atol=1e-6)
