@@ -11,10 +11,10 @@ from pathlib import Path
 
 from mission.analysis.records_file import RecordsFile, RunShape, read_records_file
 from mission.commands.common import add_run_scenario_option
-from mission.commands.run_files import previous_summary, run_scenario
 from mission.config.errors import InputError
 from mission.procs.disk_full import fresh, removed_if_disk_fills
 from mission.procs.outputs import check_output_dir
+from mission.runs.run_files import previous_summary, run_scenario
 
 
 def add_parser(commands) -> None:

@@ -11,14 +11,12 @@ from mission.analysis.lockstep import integrity_note
 from mission.commands.common import (
     add_realtime_arguments,
     add_scenario_argument,
-    preflight,
     realtime_speedup,
 )
 from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.cli_common import check_seed
-from mission.procs.disk_full import fresh, no_space_error, removed_if_disk_fills
-from mission.procs.outputs import check_output_dir, remove_run_files, run_files_in
+from mission.procs.outputs import check_output_dir, run_files_in
 from mission.runs.stall import DEFAULT_STALL_S
 
 
@@ -96,11 +94,10 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """``mission run``."""
-    import time
-
-    from mission.config.scenario import load_scenario
-    from mission.runs.orchestrator import RunFailed, run_mission
+    """``mission run``: the flags checked (each named as given), then the run prepared and
+    flown by the Python API (:mod:`mission.api.runner`), as ``mission.run`` flies it."""
+    from mission.api.runner import announce, clear, fly, prepare
+    from mission.runs.orchestrator import RunFailed
 
     if args.exit_with_parent:
         from mission.procs.cli_common import die_with_parent
@@ -108,34 +105,31 @@ def run(args: argparse.Namespace) -> int:
         die_with_parent()
     check_seed(args.seed)
     speedup = realtime_speedup(args)
-    scenario = load_scenario(args.scenario)
-    preflight(scenario)
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    out = args.out or Path("logs") / f"{scenario.name}-{args.method}-{args.seed}-{stamp}"
-    check_output_dir(out, "--out")
-    earlier = run_files_in(out)
-    if earlier and not args.force:
-        raise InputError(
-            "command line",
-            "--out",
-            f"{str(out)!r} holds a run ({earlier[0].name}): give a new folder, or --force to "
-            "write over it",
-        )
-    options = _run_options(args, out, speedup)
-    remove_run_files(out)  # --force: the earlier run's files, once every check has passed
-    print(f"running {scenario.name} ({args.method}, seed {args.seed}) into {out}", flush=True)
-    live = None
+    _check_flags(args)
+    plan = prepare(
+        args.scenario,
+        args.method,
+        args.seed,
+        None,
+        args.out,
+        speedup=speedup,
+        force=args.force,
+        signing_key=args.signing_key,
+        observer=args.observer,
+        link=link_settings(args),
+        mpc_helper=args.mpc_helper,
+        process_start=args.process_start,
+        g_snapshots=args.g_snapshots,
+        stall_s=args.stall_s,
+    )
+    out, live = plan.out, None
+    clear(plan)  # --force: the earlier run's files, once every check has passed
+    print(announce(plan), flush=True)
     try:
-        live = _live_view(args.view, out, scenario) if args.view else None
-        made = fresh(out)
-        try:
-            with removed_if_disk_fills(*made):  # a run that could not be written is none
-                summary = run_mission(options, scenario, live)
-        except OSError as error:
-            if not made and no_space_error(error) is not None:
-                remove_run_files(out)  # an --out that existed (--force): this run's files
-            raise
-        print(f"{run_line(summary, scenario.run.timeout_s)}; summary in {out / 'summary.json'}")
+        live = _live_view(args.view, out, plan.scenario) if args.view else None
+        summary = fly(plan, live)
+        timeout_s = plan.scenario.run.timeout_s
+        print(f"{run_line(summary, timeout_s)}; summary in {out / 'summary.json'}")
         if live is not None and live.viewer is not None:
             from mission.viewer.replay import wait_for_viewer
 
@@ -149,10 +143,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_options(args: argparse.Namespace, out: Path, speedup: float | None):
-    """The run's options from the command line, each flag checked before anything starts."""
-    from mission.runs.orchestrator import RunOptions
-
+def _check_flags(args: argparse.Namespace) -> None:
+    """The flags that name files, folders and addresses, each checked before anything
+    starts and named as given."""
     if not (0 <= args.stall_s < float("inf")):
         problem = f"must be finite and >= 0, not {args.stall_s}"
         raise InputError("command line", "--stall-s", problem)
@@ -167,20 +160,16 @@ def _run_options(args: argparse.Namespace, out: Path, speedup: float | None):
             parse_address(args.observer, "--observer")
         except ValueError as error:
             raise InputError("command line", "--observer", str(error)) from None
-    return RunOptions(
-        args.scenario,
-        args.method,
-        args.seed,
-        out,
-        speedup,
-        args.signing_key.resolve() if args.signing_key else None,
-        args.observer,
-        link_settings(args),
-        args.mpc_helper,
-        args.process_start,
-        args.g_snapshots,
-        args.stall_s,
-    )
+    if args.out is not None:
+        check_output_dir(args.out, "--out")
+        earlier = run_files_in(args.out)
+        if earlier and not args.force:
+            raise InputError(
+                "command line",
+                "--out",
+                f"{str(args.out)!r} holds a run ({earlier[0].name}): give a new folder, or "
+                "--force to write over it",
+            )
 
 
 def _live_view(choice: str, out: Path, scenario):

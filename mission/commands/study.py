@@ -7,11 +7,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from mission.commands.study_checks import check_study_outputs, checked_engine
+from mission.api.study_checks import check_study_outputs
 from mission.commands.study_verify import add_verify_arguments, verify_command
 from mission.config.errors import InputError
-from mission.procs.disk_full import fresh, removed_if_disk_fills
-from mission.procs.interrupts import StopRequest
 
 
 def add_parser(commands) -> None:
@@ -108,17 +106,12 @@ def _report_only(spec, out: Path, historical: str | None) -> int:
 
 
 def run_study_command(spec, out: Path, args: argparse.Namespace) -> int:
-    """Check everything, then run the study on the chosen engine (which keys every run
-    before it starts any), the canary first."""
-    from mission.studies.study import run_study
+    """The study run by the Python API's :func:`~mission.api.studies.conduct`: checked, then
+    on the chosen engine, the canary first."""
+    from mission.api.studies import conduct
 
-    engine = checked_engine(spec, out, args)
-    # Ctrl-C and SIGTERM stop the study, even where it was started with SIGINT ignored (in the
-    # background): then `kill -INT` cancels it as Ctrl-C would.
-    made = fresh(out, *([args.runs] if args.runs is not None else []))
     try:
-        with StopRequest(), removed_if_disk_fills(*made):  # a fresh study's start, not kept
-            outcome = run_study(spec, out, engine, args.keep, runs_dir=args.runs, canary=True)
+        outcome = conduct(spec, out, args.engine, args.keep, args.runs, args.jobs, args.address)
     except KeyboardInterrupt:
         print(f"study interrupted; finished runs are kept in {out}: run it again to resume")
         return 130

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from mission.commands.study_checks import checked_engine
+from mission.api.study_checks import checked_engine
 from mission.config.errors import InputError
 from mission.procs.interrupts import StopRequest
 
@@ -61,7 +61,7 @@ def verify_command(spec, args: argparse.Namespace) -> int:
         raise InputError(
             "command line", "--out", "must not be --against (nothing is written there)"
         )
-    engine = checked_engine(spec, out, args)
+    engine = checked_engine(spec, out, args.jobs, args.runs, args.engine, args.address)
     try:
         with StopRequest():
             outcome = run_verify(

@@ -8,9 +8,9 @@ import sys
 from pathlib import Path
 
 from mission.commands.common import add_run_scenario_option
-from mission.commands.run_files import previous_summary, run_scenario
 from mission.config.errors import InputError
 from mission.procs.outputs import check_output_file
+from mission.runs.run_files import previous_summary, run_scenario
 
 
 def add_parser(commands) -> None:

@@ -67,6 +67,7 @@ def _check_writable_ancestor(path: Path, flag: str) -> None:
 # What a run writes into its folder (mission run --out): a folder holding any of them holds a
 # run, which a new one would mix with or overwrite.
 RUN_FILES = ("gcs.tlog", "records.jsonl", "summary.json", "link.json", "ground_station.log")
+RUN_FILES += ("resolved-scenario.yaml",)  # what a run with overrides flew (mission.api)
 RUN_FILE_PATTERNS = ("work.log", "support-*.log", "viewer.log", "g", "plots")
 
 

@@ -171,6 +171,15 @@ def load_study(path: Path, say: Callable[[str], None] | None = None) -> StudySpe
     if say is not None and size > ANNOUNCED_BYTES:
         say(f"reading {source} ({size / 1e6:.1f} MB)")
     data = read_yaml_mapping(path) if path.is_file() else _missing(path)
+    return study_from_mapping(data, path, say)
+
+
+def study_from_mapping(
+    data: dict[str, Any], path: Path, say: Callable[[str], None] | None = None
+) -> StudySpec:
+    """Validate a study given as the mapping its file would hold; ``path``: the file it
+    stands for (its name's default, and what relative scenario paths are relative to)."""
+    source = str(path)
     unknown = sorted(set(map(str, data)) - _KEYS)
     if unknown:
         raise InputError(source, unknown[0], f"unknown key (expected one of: {_known()})")

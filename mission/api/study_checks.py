@@ -3,27 +3,27 @@ folders, the scenarios and their files), and the engine it then runs on."""
 
 from __future__ import annotations
 
-import argparse
 import os
 from pathlib import Path
 
-from mission.commands.common import preflight
 from mission.config.errors import InputError
 from mission.procs.outputs import check_output_dir
+from mission.runs.preflight import preflight
 
 MAX_JOBS = 256
 
 
-def checked_engine(spec, out: Path, args: argparse.Namespace):
+def checked_engine(
+    spec, out: Path, jobs: int | None, runs: Path | None, engine: str, address: str | None
+):
     """Every check a study's run gets before anything is written (the arguments, the output
-    folders, the scenarios and their files); then the engine."""
-    jobs = args.jobs
+    folders, the scenarios and their files); then the engine (``local`` or ``ray``)."""
     if jobs is not None and not 1 <= jobs <= MAX_JOBS:
         raise InputError("command line", "--jobs", f"must be in [1, {MAX_JOBS}], got {jobs}")
     check_output_dir(out, "--out")
-    if args.runs is not None:
-        check_output_dir(args.runs, "--runs")
-    check_study_outputs(out, args.runs)
+    if runs is not None:
+        check_output_dir(runs, "--runs")
+    check_study_outputs(out, runs)
     repeated = [s for i, s in enumerate(spec.scenarios) if s in spec.scenarios[:i]]
     if repeated:
         field = "SCENARIO" if spec.source == Path("command line") else "scenarios"
@@ -31,7 +31,7 @@ def checked_engine(spec, out: Path, args: argparse.Namespace):
     names = _check_scenarios(spec)
     if len(set(names.values())) != len(names):
         raise InputError(str(spec.source), "scenarios", "two scenarios have the same name")
-    return _engine(args)
+    return _engine(engine, address, jobs)
 
 
 STUDY_FILES = (
@@ -70,15 +70,15 @@ def _check_scenarios(spec) -> dict[str, str]:
     return {reference: resolved[(reference, 0)].name for reference in spec.scenarios}
 
 
-def _engine(args: argparse.Namespace):
-    if args.engine == "ray":
+def _engine(engine: str, address: str | None, jobs: int | None):
+    if engine == "ray":
         from mission.studies.ray_engine import RayEngine, check_reachable, require_ray
 
         require_ray()
-        check_reachable(args.address, "--address" if args.address else "RAY_ADDRESS")
-        return RayEngine(args.address, args.jobs)
-    if args.address is not None:
+        check_reachable(address, "--address" if address else "RAY_ADDRESS")
+        return RayEngine(address, jobs)
+    if address is not None:
         raise InputError("command line", "--address", "is for --engine ray")
     from mission.studies.local_engine import LocalEngine
 
-    return LocalEngine(args.jobs or os.cpu_count() or 1)
+    return LocalEngine(jobs or os.cpu_count() or 1)
