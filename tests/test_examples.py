@@ -16,7 +16,6 @@ EXAMPLES = ROOT / "examples"
 SCRIPTS = sorted(p.name for p in EXAMPLES.glob("*.py"))
 MADE = {  # what each example must leave in its folder
     "first_run.py": ["summary.json"],
-    "ac_vs_nac.py": ["error.png", "ac/summary.json", "nac/summary.json"],
     "sweep.py": ["results.csv", "report.md"],
     "custom_structure.py": ["bridge.stl", "run/summary.json", "run/resolved-scenario.yaml"],
     "fault_from_pymavlink.py": ["summary.json"],
