@@ -63,6 +63,7 @@ def test_the_notebook_runs(tmp_path):
     resources = {"metadata": {"path": str(tmp_path)}}
     NotebookClient(notebook, timeout=600, resources=resources).execute(env=environment)
     assert (tmp_path / "notebook" / "support-1.png").is_file()
+    assert (tmp_path / "notebook" / "error.png").is_file()
     printed = "".join(
         output.get("text", "") for cell in notebook.cells for output in cell.get("outputs", [])
     )
