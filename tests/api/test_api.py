@@ -99,6 +99,16 @@ def test_the_frames_are_the_runs_own_numbers(short_run):
 
 
 @pytest.mark.slow
+def test_figures_and_view_are_the_command_lines(short_run, tmp_path):
+    run_dir, _ = short_run
+    run = mission.load_run(run_dir)
+    written = run.figures(tmp_path / "plots")
+    assert sorted(p.name for p in written) == ["error.png", "g_update.png", "trajectories.png"]
+    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in written)
+    assert run.view(save=tmp_path / "run.rrd") == 0 and (tmp_path / "run.rrd").stat().st_size > 0
+
+
+@pytest.mark.slow
 def test_overrides_fly_and_read_back(tmp_path):
     run = mission.run(
         "along",
