@@ -17,12 +17,27 @@ def build_parser() -> OneLineArgumentParser:
         prog=program_name("mission", "mission"),
         description="Run, batch, analyse and inspect missions of the bridge-inspection UAVs.",
     )
+    parser.add_argument(
+        "--version", action="version", version=f"%(prog)s {_version_text()}", help="say the version"
+    )
     commands = parser.add_subparsers(
         dest="command", required=True, metavar="COMMAND", parser_class=OneLineArgumentParser
     )
     for command in COMMANDS:
         command.add_parser(commands)
     return parser
+
+
+def _version_text() -> str:
+    """The package's version, and the commit where this is a git checkout."""
+    from mission.procs.provenance import code_identity
+
+    code = code_identity()
+    version = code["version"] or "unknown"
+    if code["commit"] is None:
+        return version
+    changed = ", with changes" if code["dirty"] else ""
+    return f"{version} (commit {code['commit'][:12]}{changed})"
 
 
 def main(argv: Sequence[str] | None = None) -> int:

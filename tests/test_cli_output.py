@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from mission.commands.run import run_line
 
 SUMMARY = {
@@ -82,3 +84,17 @@ def test_a_run_whose_inspections_were_not_done_says_so_beside_the_work_uav_s_com
     assert line.startswith(
         "completed at 254.5 s, inspections NOT done within 900 s (support-2); 509 cycles;"
     )
+
+
+def test_version_says_the_package_and_the_commit(capsys):
+    from mission.cli import entry_point
+    from mission.procs.provenance import code_identity
+
+    with pytest.raises(SystemExit) as stopped:
+        entry_point(["--version"])
+    assert stopped.value.code == 0
+    said = capsys.readouterr().out.strip()
+    code = code_identity()
+    assert f"mission {code['version'] or 'unknown'}" in said
+    if code["commit"]:
+        assert code["commit"][:12] in said
