@@ -82,7 +82,17 @@ def test_a_run_whose_inspections_were_not_done_says_so_beside_the_work_uav_s_com
     }
     line = run_line({**SUMMARY, "roles": {"waypoints_reached": reached}}, 900.0)
     assert line.startswith(
-        "completed at 254.5 s, inspections NOT done within 900 s (support-2); 509 cycles;"
+        "work task completed at 254.5 s, inspections NOT done within 900 s (support-2); 509 cycles;"
+    )
+
+
+def test_a_run_with_inspections_says_when_each_task_was_done():
+    """Piers: the work UAV's task at 389 s, the last inspection at 467 s (934 cycles)."""
+    reached = {"work": {"reached": 24, "of": 24}, "support-1": {"reached": 4, "of": 4}}
+    roles = {"waypoints_reached": reached, "all_done_s": 467.0}
+    summary = {**SUMMARY, "completion_time_s": 389.0, "control_cycles": 934, "roles": roles}
+    assert run_line(summary, 900.0).startswith(
+        "work task completed at 389.0 s, every inspection done at 467.0 s; 934 cycles;"
     )
 
 

@@ -192,11 +192,16 @@ def _live_view(choice: str, out: Path, scenario):
 def run_line(summary: dict, timeout_s: float) -> str:
     """A finished run in one line of text."""
     if summary["completed"]:
-        done = f"completed at {summary['completion_time_s']:.1f} s"
-        reached = ((summary.get("roles") or {}).get("waypoints_reached")) or {}
+        roles = summary.get("roles") or {}
+        reached = roles.get("waypoints_reached") or {}
         behind = [n for n, w in reached.items() if n != "work" and w["reached"] < w["of"]]
+        inspected = any(n != "work" for n in reached)
+        work = "work task " if inspected else ""
+        done = f"{work}completed at {summary['completion_time_s']:.1f} s"
         if behind:  # the work UAV's task done, a support's inspections not
             done += f", inspections NOT done within {timeout_s:g} s ({', '.join(behind)})"
+        elif inspected and roles.get("all_done_s") is not None:
+            done += f", every inspection done at {roles['all_done_s']:.1f} s"
     elif summary.get("stopped"):
         done = f"STOPPED: {summary['stopped']}"
     else:
