@@ -282,8 +282,3 @@ def autopilot_version(system_id: int) -> mavlink2.MAVLink_autopilot_version_mess
         system_id,
         [0] * 18,
     )
-
-
-def statustext(severity: int, text: str) -> mavlink2.MAVLink_statustext_message:
-    """STATUSTEXT (text cut to the field's 50 bytes)."""
-    return mavlink2.MAVLink_statustext_message(severity, text.encode()[:50], 0, 0)

@@ -19,6 +19,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.config.settings import Scenario
 from mission.config.wind_settings import WindSettings
 from mission.link.mavlink_udp import LinkCounters
+from mission.link.statustext import statustexts
 from mission.link.vehicle_events import event_text, parameter_change
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame
@@ -87,6 +88,7 @@ class Vehicle:
         self.failsafe = False
         self.last_setpoint_s = 0.0
         self.last_warning = ("", -math.inf)  # the last warning said, and when
+        self._text_id = 0  # the last id of a STATUSTEXT sent in chunks
         self.last_estimate_usec: dict[tuple[int, int], int] = {}  # per sender: the last taken
         self.last_setpoint_seen: dict[tuple[int, int], tuple] = {}  # per sender: stamp, content
         vs = scenario.vehicle
@@ -174,8 +176,11 @@ class Vehicle:
 
     # -- outgoing ---------------------------------------------------------------------------
     def notify(self, severity: int, text: str) -> None:
-        """Send a STATUSTEXT event."""
-        self.send(telemetry.statustext(severity, text))
+        """Send a STATUSTEXT event; a text longer than its 50-byte field in chunks (MAVLink
+        2's ``id`` and ``chunk_seq``), so that no refusal is cut short."""
+        self._text_id = self._text_id % 65535 + 1
+        for message in statustexts(text, self._text_id, severity):
+            self.send(message)
 
     def heartbeat(self) -> Any:
         """The HEARTBEAT describing armed state and mode."""

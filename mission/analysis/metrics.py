@@ -94,6 +94,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     replies: list[TimesyncReply] = []
     chunks = StatusChunks()  # the ground station's long STATUSTEXTs
     said: set[tuple[int, str]] = set()  # the vehicles' texts so far
+    vehicle_chunks: dict[int, StatusChunks] = {}  # each vehicle's long texts
     for message in messages:
         kind = message.get_type()
         t = round(message._timestamp - epoch, 3)
@@ -111,7 +112,9 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
             samples.stamp(source, int(message.time_unix_usec))
         elif kind == "STATUSTEXT" and source != GCS_SYSTEM_ID:
-            _vehicle_said(trace, said, source, message.text)
+            text = vehicle_chunks.setdefault(source, StatusChunks()).add(message)
+            if text is not None:  # a long one once its last chunk is in
+                _vehicle_said(trace, said, source, text)
         elif kind == "TIMESYNC" and source != GCS_SYSTEM_ID:
             received_ns = round(message._timestamp * 1e9 - epoch * 1e9)
             replies.append(TimesyncReply(source, message.tc1, message.ts1, received_ns))

@@ -9,6 +9,7 @@ import time
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.link.statustext import StatusChunks
 from tests.mav_client import MavClient
 from tests.processes import vehicle_process
 
@@ -79,12 +80,13 @@ def test_a_set_is_echoed_and_kept(client):
     ("name", "value", "kind", "reason"),
     [
         ("SIM_SPEEDUP", 10.0, mavlink2.MAV_PARAM_TYPE_REAL32, "the run's clock"),
+        ("SIM_RATE_HZ", 4.0, mavlink2.MAV_PARAM_TYPE_INT32, "set it in the scenario"),
         ("FS_GCS_TIMEOUT", math.nan, mavlink2.MAV_PARAM_TYPE_REAL32, "finite"),
         ("FS_GCS_TIMEOUT", 1e6, mavlink2.MAV_PARAM_TYPE_REAL32, "must be in"),
         ("FS_GCS_TIMEOUT", 5.0, 0, "param type 0 unknown"),
         ("SIM_GPS1_ENABLE", 0.5, mavlink2.MAV_PARAM_TYPE_REAL32, "whole number"),
     ],
-    ids=["read-only", "nan", "out-of-range", "no-type", "integer-not-whole"],
+    ids=["read-only", "long-refusal", "nan", "out-of-range", "no-type", "integer-not-whole"],
 )
 def test_a_refused_set_is_echoed_unchanged_and_said_why(client, name, value, kind, reason):
     before = _read(client, name).param_value
@@ -132,9 +134,14 @@ def test_an_unknown_id_is_said_and_gets_no_value(client):
 
 
 def _said(client: MavClient, name: str) -> list[str]:
-    """The STATUSTEXTs about ``name`` that have come (before or after its echo)."""
+    """The STATUSTEXTs about ``name`` that have come (before or after its echo), long ones
+    put together from their chunks."""
     client.collect(0.2)
-    return [m.text for m in client.seen if m.get_type() == "STATUSTEXT" and name in m.text]
+    chunks, texts = StatusChunks(), []
+    for message in client.seen:
+        if message.get_type() == "STATUSTEXT" and (text := chunks.add(message)) is not None:
+            texts.append(text)
+    return [text for text in texts if name in text]
 
 
 def test_link_loss_set_live_thins_what_the_vehicle_sends():
