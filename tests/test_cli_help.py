@@ -22,7 +22,7 @@ def _parsers() -> list[tuple[str, argparse.ArgumentParser]]:
 
 
 def _arguments(parser: argparse.ArgumentParser) -> list[argparse.Action]:
-    skipped = (argparse._HelpAction, argparse._SubParsersAction)
+    skipped = (argparse._HelpAction, argparse._VersionAction, argparse._SubParsersAction)
     return [
         a for a in parser._actions if not isinstance(a, skipped) and a.help != argparse.SUPPRESS
     ]

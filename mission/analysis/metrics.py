@@ -93,8 +93,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     samples = _StepSamples()
     replies: list[TimesyncReply] = []
     chunks = StatusChunks()  # the ground station's long STATUSTEXTs
-    said: set[tuple[int, str]] = set()  # the vehicles' texts so far
-    vehicle_chunks: dict[int, StatusChunks] = {}  # each vehicle's long texts
+    vehicle_texts = _VehicleTexts()
     for message in messages:
         kind = message.get_type()
         t = round(message._timestamp - epoch, 3)
@@ -112,9 +111,7 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "SYSTEM_TIME" and source != GCS_SYSTEM_ID:
             samples.stamp(source, int(message.time_unix_usec))
         elif kind == "STATUSTEXT" and source != GCS_SYSTEM_ID:
-            text = vehicle_chunks.setdefault(source, StatusChunks()).add(message)
-            if text is not None:  # a long one once its last chunk is in
-                _vehicle_said(trace, said, source, text)
+            vehicle_texts.add(trace, source, message)
         elif kind == "TIMESYNC" and source != GCS_SYSTEM_ID:
             received_ns = round(message._timestamp * 1e9 - epoch * 1e9)
             replies.append(TimesyncReply(source, message.tc1, message.ts1, received_ns))
@@ -147,18 +144,27 @@ def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
     return trace
 
 
-def _vehicle_said(trace: RunTrace, said: set[tuple[int, str]], source: int, text: str) -> None:
-    """A vehicle's contact or event, once: each names its time, so the same text again is a
-    copy (a step sent again carries what the vehicle said in it)."""
-    if (source, text) in said:
-        return
-    said.add((source, text))
-    contact = _CONTACT.match(text)
-    if contact:
-        trace.contacts.append(_contact_event(source, contact))
-    event = parse_event(text, VehicleIdentity.from_system_id(source).name)
-    if event is not None:
-        trace.events.append(event)
+class _VehicleTexts:
+    """The vehicles' STATUSTEXTs, each vehicle's long ones put together from their chunks,
+    each text taken once: it names its time, so the same text again is a copy (a step sent
+    again carries what the vehicle said in it)."""
+
+    def __init__(self) -> None:
+        self._said: set[tuple[int, str]] = set()
+        self._chunks: dict[int, StatusChunks] = {}
+
+    def add(self, trace: RunTrace, source: int, message: Any) -> None:
+        """A vehicle's contact or event into ``trace`` once its text is whole and new."""
+        text = self._chunks.setdefault(source, StatusChunks()).add(message)
+        if text is None or (source, text) in self._said:
+            return
+        self._said.add((source, text))
+        contact = _CONTACT.match(text)
+        if contact:
+            trace.contacts.append(_contact_event(source, contact))
+        event = parse_event(text, VehicleIdentity.from_system_id(source).name)
+        if event is not None:
+            trace.events.append(event)
 
 
 def _station_said(trace: RunTrace, text: str, t: float) -> None:
