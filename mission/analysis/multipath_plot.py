@@ -17,6 +17,7 @@ import numpy as np
 from matplotlib.collections import PolyCollection
 
 from mission.analysis.figures import save_figure
+from mission.config.errors import InputError
 from mission.link.plan_files import read_vehicle_waypoints, vehicle_names
 from mission.world.model import World
 from mission.world.multipath import GeometricReceiver, ReceiverSolution
@@ -44,7 +45,7 @@ def mission_heights(world: World) -> list[float]:
     try:
         for name in vehicle_names(scenario.task.supports)[1:]:
             heights += [round(float(z), 2) for z in read_vehicle_waypoints(scenario, name)[:, 2]]
-    except (OSError, ValueError):  # no plan: the work UAV's heights
+    except InputError:  # no plan (yet): the work UAV's heights
         heights = []
     if not heights:
         heights = [round(float(p[2]), 2) for p in scenario.task.work_waypoints_m]

@@ -115,3 +115,14 @@ def test_the_multipath_map_is_drawn_and_names_its_worst_point(tmp_path, capsys):
 def test_a_bad_multipath_map_path_is_refused_before_anything_is_computed(tmp_path, capsys):
     status, _, err = _mission(capsys, "world", "river", "--multipath-map", str(tmp_path / "m.txt"))
     assert status == 2 and "--multipath-map" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_multipath_map_of_an_unplanned_scenario_slices_at_the_work_uavs_heights(
+    write_scenario,
+):
+    from mission.analysis.multipath_plot import mission_heights
+    from mission.config.scenario import load_scenario
+    from mission.world.model import World
+
+    path = write_scenario("extends: river\nname: unplanned\ntask: {waypoints_dir: nowhere}\n")
+    assert mission_heights(World(load_scenario(str(path)))) == [7.0]
