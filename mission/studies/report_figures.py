@@ -103,22 +103,28 @@ def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
 
 
 def _frame(figure, axes, title: str, key_lines: list[str], key_height: float) -> None:
-    """The title on top, the legend in two columns under it, the panels below both, and the
-    names of lettered points (if any) under the panels."""
-    handles, labels = axes[0][0].get_legend_handles_labels()
+    """The title on top (wrapped to the figure's width), the legend of every panel's lines in
+    two columns under it, the panels below both, and the names of lettered points (if any)
+    under the panels."""
+    named = {}  # every line of every panel, once (a method may be missing from the first)
+    for axis in (a for row in axes for a in row):
+        for handle, label in zip(*axis.get_legend_handles_labels()):
+            named.setdefault(label, handle)
     height = figure.get_figheight()
-    legend_rows = -(-len(labels) // 2)
-    figure.suptitle(title, y=1 - 0.12 / height)
+    legend_rows = -(-len(named) // 2)
+    lines = textwrap.wrap(title, width=int(11 * figure.get_figwidth()))  # a narrow figure's
+    extra = 0.22 * (len(lines) - 1)
+    figure.suptitle("\n".join(lines), y=1 - 0.12 / height)
     figure.legend(
-        handles,
-        labels,
+        list(named.values()),
+        list(named),
         loc="upper center",
-        bbox_to_anchor=(0.5, 1 - 0.42 / height),
+        bbox_to_anchor=(0.5, 1 - (0.42 + extra) / height),
         ncol=2,
         fontsize=7,
         frameon=False,
     )
-    top = 1 - (0.55 + 0.2 * legend_rows) / height
+    top = 1 - (0.55 + extra + 0.2 * legend_rows) / height
     if key_lines:
         figure.text(0.02, 0.1 / height, "\n".join(key_lines), fontsize=7, va="bottom")
     figure.tight_layout(rect=(0, key_height / height, 1, top))

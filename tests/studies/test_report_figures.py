@@ -70,3 +70,33 @@ def test_many_long_point_names_are_letters_under_the_ticks_and_listed_below(tmp_
     listed = "\n".join(text.get_text() for text in figure.texts)
     for letter, size in zip("ABCDE", (1, 2, 3, 4, 5), strict=True):
         assert f"{letter}: support-1 SIM_GPS1_GLTCH_Z={size:g}" in listed
+
+
+def test_the_legend_names_a_method_missing_from_the_first_panel_and_the_title_fits(
+    tmp_path, drawn, monkeypatch
+):
+    """No NAC run completes, so the first panel (completion time) has AC's line alone: the
+    legend still names NAC's lines from the other panels, and the long title is wrapped to a
+    one-scenario figure's width."""
+    from tests.studies import test_study
+
+    plain = test_study._summary
+
+    def nac_never_completes(run):
+        summary = plain(run)
+        if run.method == "nac":
+            summary.update(completed=False, completion_time_s=None)
+        return summary
+
+    monkeypatch.setattr(test_study, "_summary", nac_never_completes)
+    _study(
+        tmp_path, (Point((("integrity.enabled", False),)), Point((("integrity.enabled", True),)))
+    )
+    figure = drawn["metrics-vs-integrity.enabled.png"]
+    assert figure.axes[0].get_legend_handles_labels()[1] == ["AC"]
+    labels = [text.get_text() for legend in figure.legends for text in legend.get_texts()]
+    assert labels == ["AC", "NAC"]
+    title = figure._suptitle.get_text()
+    assert "\n" in title and all(
+        len(line) <= 11 * figure.get_figwidth() for line in title.split("\n")
+    )
