@@ -15,6 +15,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+# ``mission run``'s documented status for a run flown to its end without completing
+# (docs/robustness.md, "Exit statuses"); written out here, not imported, so that a change of it
+# fails the tests that use it
+EXIT_NOT_COMPLETED = 4
 _LISTENING = re.compile(r"listening on ([\d.]+):(\d+)(?:, truth port (\d+))?")
 
 

@@ -1,4 +1,4 @@
-"""The supports' true GNSS errors in a run (issue 47), from the tlog: every 3-D fix a support
+"""The supports' true GNSS errors in a run, from the tlog: every 3-D fix a support
 reported against its truth at that step.
 
 - ``gnss_multipath``: where the errors came from (the scenario's ``world.gnss.multipath``);

@@ -1,4 +1,4 @@
-"""Does G learn the right places? (issue 47) A run's final map against the true error field
+"""Does G learn the right places? A run's final map against the true error field
 that multipath from geometry makes (the receiver's fix error without noise at each voxel's
 centre; a voxel without a fix counts as the worst, one inside the structure not at all).
 

@@ -60,17 +60,12 @@ _WANTED_IDS = frozenset(
 
 def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
     """Truth (SIM_STATE), the work UAV's estimates, clock ticks and completion from a tlog."""
-    return _trace_of(_tlog_messages(tlog), scenario)
+    return trace_of_messages(_tlog_messages(tlog), scenario)
 
 
-def read_tlog_with_mavutil(tlog: Path, scenario: Scenario) -> RunTrace:
-    """The same as :func:`read_tlog` through pymavlink's own tlog reader (every message
-    decoded; slower): the reference the fast reader is tested against."""
-    return _trace_of(_mavutil_messages(tlog), scenario)
-
-
-def _mavutil_messages(tlog: Path) -> Iterator[Any]:
-    """Every message of a tlog through pymavlink's tolerant reader."""
+def pymavlink_messages(tlog: Path) -> Iterator[Any]:
+    """Every message of a tlog through pymavlink's tolerant reader (every message decoded;
+    slower than the fast path, which falls back to it for a file it cannot index)."""
     from pymavlink import mavutil  # 0.1 s to import (every dialect); the fast path needs none
 
     try:
@@ -84,7 +79,9 @@ def _mavutil_messages(tlog: Path) -> Iterator[Any]:
         ) from None
 
 
-def _trace_of(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
+def trace_of_messages(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
+    """What :func:`read_tlog` makes of a tlog, from its messages however they were decoded
+    (pymavlink's own reader gives the same)."""
     frame = GeodeticFrame(scenario.world.anchor)
     epoch = scenario.run.epoch_unix_s
     sample_s = max(scenario.control.t_cont_s, 1.0 / scenario.vehicle.sensor_hz)
@@ -228,7 +225,7 @@ def _tlog_messages(tlog: Path) -> Iterator[Any]:
     data = tlog.read_bytes()
     records = _wanted_records(data)
     if records is None:
-        yield from _mavutil_messages(tlog)
+        yield from pymavlink_messages(tlog)
         return
     parser, fast = mavlink2.MAVLink(None), FastDecoder()
     for usec, packet in records:
@@ -292,11 +289,6 @@ def work_errors(trace: RunTrace) -> tuple[np.ndarray, np.ndarray]:
     estimates = np.array([trace.estimates[t] for t in times]).reshape(-1, 3)
     errors = np.linalg.norm(estimates[known] - truth[known], axis=1)
     return np.array(times)[known], errors
-
-
-def analyze_tlog(tlog: Path, scenario: Scenario) -> dict[str, Any]:
-    """The tlog-determined metrics of summary.json."""
-    return trace_metrics(read_tlog(tlog, scenario), World(scenario))
 
 
 def trace_metrics(trace: RunTrace, world: World) -> dict[str, Any]:

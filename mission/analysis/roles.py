@@ -1,4 +1,4 @@
-"""Who did what in a run (issue 33): the ``roles`` block of summary.json.
+"""Who did what in a run: the ``roles`` block of summary.json.
 
 - ``all_done_s``: when all the inspection work was done, the work UAV's task and every
   support's own inspection waypoints (the work UAV's completion where no support has any);

@@ -19,7 +19,7 @@ import time
 
 from mission.bench.result import BenchResult
 
-RUN_CPU_TARGET_S = 3.5  # CPU seconds of a whole Along AC run at the reference speed (issue 34)
+RUN_CPU_TARGET_S = 3.5  # CPU seconds of a whole Along AC run at the reference speed
 
 
 def bench_floor(repeats: int = 3, max_cycles: int = 1000) -> list[BenchResult]:

@@ -1,4 +1,4 @@
-"""What the integrity monitor (issue 45) costs the control cycle: a detached Along AC run with
+"""What the integrity monitor costs the control cycle: a detached Along AC run with
 ``integrity.enabled`` against one without, stepped in turn cycle by cycle
 (:mod:`mission.bench.paired`). Along's support 1 crosses the zone, so the monitor excludes,
 places by the formation and restores, as well as testing every fix."""

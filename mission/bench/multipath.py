@@ -1,4 +1,4 @@
-"""What multipath from geometry (issue 47) costs a run: the same flight's GNSS fixes made by
+"""What multipath from geometry costs a run: the same flight's GNSS fixes made by
 both models.
 
 A run with ``geometry`` flies differently from one with ``zones`` (other errors, other

@@ -1,4 +1,4 @@
-"""What dynamic roles (issue 33) cost the control cycle: a detached Piers AC run with the
+"""What dynamic roles cost the control cycle: a detached Piers AC run with the
 dynamic policy (the work UAV's own fix judged, the look-ahead, releases, recalls and routes)
 against the paper's cycle (fixed roles, no inspections: nothing of the roles runs), on the
 same waypoints, stepped in turn cycle by cycle (:mod:`mission.bench.paired`). Piers' first

@@ -30,7 +30,7 @@ from mission.procs.machine_speed import REFERENCE_LOOP_S, children_cpu_s, python
 from mission.procs.stopping import stop_processes
 
 REALTIME_FACTOR_TARGET = 100.0  # Along AC's lockstep real-time factor there
-MULTICOPTER_ALONG = (  # issue 31's: Along AC flown by quadrotors in a 3 m/s gusty wind
+MULTICOPTER_ALONG = (  # Along AC flown by quadrotors in a 3 m/s gusty wind
     "extends: along\nname: along-multicopter\nvehicle: {dynamics: multicopter}\n"
     "world: {wind: {speed_m_s: 3.0}}\n"
 )

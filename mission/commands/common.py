@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.config.scenario import embedded_scenario_names
 from mission.procs.cli_common import check_speedup
 from mission.procs.outputs import check_output_dir, check_output_file
 
@@ -20,7 +21,7 @@ def add_scenario_argument(parser: argparse.ArgumentParser) -> None:
         "scenario",
         nargs="?",
         default=DEFAULT_SCENARIO,
-        help="embedded name (along, wall) or YAML path",
+        help=f"embedded name ({', '.join(embedded_scenario_names())}) or YAML path",
     )
 
 

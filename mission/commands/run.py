@@ -97,6 +97,7 @@ def run(args: argparse.Namespace) -> int:
     """``mission run``: the flags checked (each named as given), then the run prepared and
     flown by the Python API (:mod:`mission.api.runner`), as ``mission.run`` flies it."""
     from mission.api.runner import announce, clear, fly, prepare
+    from mission.procs.cli_common import EXIT_NOT_COMPLETED
     from mission.runs.orchestrator import RunFailed
 
     if args.exit_with_parent:
@@ -128,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         live = _live_view(args.view, out, plan.scenario) if args.view else None
         summary = fly(plan, live)
+        status = 0 if summary["completed"] else EXIT_NOT_COMPLETED
         timeout_s = plan.scenario.run.timeout_s
         print(f"{run_line(summary, timeout_s)}; summary in {out / 'summary.json'}")
         if live is not None and live.viewer is not None:
@@ -140,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if live is not None:
             live.close()
-    return 0
+    return status
 
 
 def _check_flags(args: argparse.Namespace) -> None:

@@ -1,4 +1,4 @@
-"""Whether a multicopter's settings can be flown and integrated (issue 46): checked up front,
+"""Whether a multicopter's settings can be flown and integrated: checked up front,
 so that a body or loop the model cannot integrate is refused on one line, not found out by
 every vehicle dying at its first step.
 

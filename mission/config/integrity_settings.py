@@ -1,4 +1,4 @@
-"""The ground station's integrity monitor (issue 45): its tests' error rates, how long a fault
+"""The ground station's integrity monitor: its tests' error rates, how long a fault
 must persist to exclude a support and to restore it, and what an excluded support is given
 (:mod:`ground_station.integrity`)."""
 

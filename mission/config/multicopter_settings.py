@@ -1,4 +1,4 @@
-"""The rigid body of a simulated multicopter (issue 31): mass, inertia, rotors, drag, and the
+"""The rigid body of a simulated multicopter: mass, inertia, rotors, drag, and the
 rate it is integrated at.
 
 The defaults are a ~1.5 kg inspection quadrotor, scaled from PX4's SIH defaults for a 1 kg

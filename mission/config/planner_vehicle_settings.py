@@ -16,7 +16,8 @@ from mission.config.multicopter_settings import AutopilotSettings, MulticopterSe
 
 @dataclass(frozen=True)
 class PlannerSettings:
-    """The offline planner of the support UAVs' paths (MODEL.md 3.3; the paper's ref. [18])."""
+    """The offline planner of the support UAVs' paths (docs/model.md, "Pre-planned support
+    paths"; the paper's ref. [18])."""
 
     lattice_m: float
     w_gnss_per_m2: float

@@ -1,4 +1,4 @@
-"""Who does what (issue 33, the paper's third open question): the work UAV on its own GNSS
+"""Who does what (the paper's third open question): the work UAV on its own GNSS
 where it can (:mod:`ground_station.roles`)."""
 
 from __future__ import annotations

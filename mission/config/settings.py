@@ -179,7 +179,8 @@ class WorldSettings:
 
 @dataclass(frozen=True)
 class FusionSettings:
-    """Selective fusion (paper 3.2.1) with the candidate-particle sets of MODEL.md."""
+    """Selective fusion (paper 3.2.1) with the candidate-particle sets of docs/model.md,
+    "Selective fusion"."""
 
     broad_particles: int
     local_particles: int
@@ -219,7 +220,7 @@ MAX_T_PRED_S = 10.0
 
 @dataclass(frozen=True)
 class ControlSettings:
-    """MPC and control-cycle parameters (paper 4.2, Table 2 as MODEL.md fills it)."""
+    """MPC and control-cycle parameters (paper 4.2, Table 2 as docs/model.md, "MPCs", fills it)."""
 
     horizon_steps: int
     t_pred_s: float
@@ -297,7 +298,7 @@ class TaskSettings:
     supports: int
     work_waypoints_m: list[Vec3]
     waypoints_dir: str
-    inspections: list[Inspection]  # each support's own, for when it is free (issue 33)
+    inspections: list[Inspection]  # each support's own, for when it is free
 
     def __post_init__(self) -> None:
         _require(1 <= self.supports <= 50, "supports", f"must be in 1..50, got {self.supports}")

@@ -1,4 +1,4 @@
-"""How the world shapes the GNSS signals a receiver gets (issue 47): the multipath model and
+"""How the world shapes the GNSS signals a receiver gets: the multipath model and
 the constants of reflections and code tracking (:mod:`mission.world.multipath`).
 
 These belong to the simulated world only: the ground station's scenario carries the defaults

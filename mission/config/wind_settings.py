@@ -1,4 +1,4 @@
-"""The wind around the bridge (issue 31): a mean wind, its Dryden turbulence, and what the
+"""The wind around the bridge: a mean wind, its Dryden turbulence, and what the
 structure does to both (:mod:`mission.world.wind`)."""
 
 from __future__ import annotations

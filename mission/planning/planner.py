@@ -1,4 +1,5 @@
-"""Offline planning of the support UAVs' paths (MODEL.md 3.3, in place of the paper's [18]).
+"""Offline planning of the support UAVs' paths (docs/model.md, "Pre-planned support paths",
+in place of the paper's [18]).
 
 For each work waypoint w_i, every support gets a point of a lattice that is free (clear of the
 structure and the ground), within camera range of w_i with a clear sight line and no closer to

@@ -1,4 +1,4 @@
-"""Placing the paper's multipath zones on a plan (MODEL.md "Scenarios").
+"""Placing the paper's multipath zones on a plan (docs/model.md, "Scenarios").
 
 Along: a 1 m x 5 m x 2 m box (long side along the segment's main horizontal axis) enclosing a
 stretch of support 1's path between two consecutive waypoints, and no other support's path.

@@ -18,12 +18,13 @@ import yaml
 
 from mission.config.scenario import resolved_mapping
 from mission.procs.atomic import write_text_atomically
-from mission.procs.cli_common import child_environment
+from mission.procs.cli_common import EXIT_NOT_COMPLETED, child_environment
 from mission.procs.commands import mission_run_argv
 from mission.studies.runkeys import StudyRun
 
 Keep = Literal["all", "logs", "summary"]
 KEEP_CHOICES = ("all", "logs", "summary")
+FLOWN = (0, EXIT_NOT_COMPLETED)  # ``mission run``'s statuses for a run flown to its end
 SCENARIO_FILE = "scenario.yaml"
 
 
@@ -58,7 +59,7 @@ def conclude(run: StudyRun, run_dir: Path, status: int, node: str, keep: Keep) -
     """The finished run's summary with the study's block added (also in its summary.json),
     or None if it failed; files beyond ``keep`` are removed."""
     summary = _read_summary(run_dir)
-    if status != 0 or summary is None or not exact(summary):
+    if status not in FLOWN or summary is None or not exact(summary):
         return None
     summary["study"] = {
         "run_key": run.key,

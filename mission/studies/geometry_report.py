@@ -1,4 +1,4 @@
-"""What a study whose multipath comes from geometry (issue 47) says beyond its report, from
+"""What a study whose multipath comes from geometry says beyond its report, from
 its kept runs::
 
     python -m mission.studies.geometry_report studies/river.yaml STUDY_OUT [--figure F.png]

@@ -30,14 +30,14 @@ METRICS = (
     ("safety.least_clearance_min_m", "least clearance of a UAV [m]"),
     ("safety.touching", "contacts (from the truth)"),
 )
-# shown where a support inspected in some run (the roles of issue 33)
+# shown where a support inspected in some run (dynamic roles)
 ROLE_METRICS = (
     ("roles.all_done_s", "all inspection work done [s]"),
     ("roles.support_minutes.inspecting", "support-minutes inspecting"),
     ("roles.role_switches", "role switches"),
     ("roles.work_error_m.shadow.mean", "work UAV error in the shadow, mean [m]"),
 )
-# shown where the integrity monitor was on in some run (issue 45)
+# shown where the integrity monitor was on in some run
 INTEGRITY_METRICS = (
     ("integrity.detected_faults", "lying faults detected"),
     ("integrity.missed_detections", "lying faults missed"),
@@ -47,7 +47,7 @@ INTEGRITY_METRICS = (
     ("integrity.protection.work.integrity_events", "work UAV integrity events"),
     ("integrity.protection.supports.integrity_events", "supports' integrity events"),
 )
-# shown where the multipath came from geometry in some run (issue 47)
+# shown where the multipath came from geometry in some run
 GNSS_METRICS = (
     ("gnss_error_steps_total", "supports' fixes off by more than the MDB"),
     ("supports_gnss_error_m.mean", "supports' GNSS error, mean [m]"),

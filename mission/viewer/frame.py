@@ -36,7 +36,7 @@ BLOCKED_COLOUR: Rgb = (255, 112, 67)
 BELOW_MARGIN_COLOUR: Rgb = (213, 0, 0)  # two UAVs closer than the separation margin
 WORST_COLOUR: Rgb = (20, 20, 20)  # the worst approach so far
 WIND_COLOUR: Rgb = (64, 160, 255)  # the free stream's arrow
-# a support off the formation (issue 33); in the formation it wears its own colour
+# a support off the formation; in the formation it wears its own colour
 ROLE_COLOURS: dict[str, Rgb] = {"inspecting": (0, 230, 118), "returning": (213, 0, 249)}
 ROLE_LEVELS = {"formation": 0, "inspecting": 1, "returning": 2}  # the roles plot's values
 G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)

@@ -1,4 +1,4 @@
-"""What a receiver's code tracking makes of a direct signal and its echoes (issue 47).
+"""What a receiver's code tracking makes of a direct signal and its echoes.
 
 The delay lock loop is a coherent early-minus-late discriminator with spacing ``d`` chips on
 the ideal triangular autocorrelation R(x) = max(0, 1 - |x|) of a BPSK code (infinite

@@ -1,8 +1,9 @@
 """GNSS of a support UAV (paper 3.1.1): visibility, dilution of precision, noisy fixes.
 
 One receiver-clock unknown per constellation that has a visible satellite, so GPS+GLONASS
-gives the 5-column geometry matrix of MODEL.md; a constellation with no visible satellite
-contributes no column (a receiver does not solve for a clock it cannot observe).
+gives the 5-column geometry matrix of docs/model.md, "GNSS of a support UAV"; a
+constellation with no visible satellite contributes no column (a receiver does not solve for
+a clock it cannot observe).
 """
 
 from __future__ import annotations

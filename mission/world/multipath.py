@@ -1,4 +1,4 @@
-"""A GNSS receiver near a structure (issue 47): which signals it tracks, the pseudorange error
+"""A GNSS receiver near a structure: which signals it tracks, the pseudorange error
 each carries, and the position it solves from them.
 
 Per satellite above the mask, from the paths of :mod:`mission.world.reflections`:

@@ -1,5 +1,5 @@
-"""First-order specular reflections of satellite signals off the structure and the ground
-(issue 47), found by the image method.
+"""First-order specular reflections of satellite signals off the structure and the ground,
+found by the image method.
 
 A satellite is far enough to be a direction ``e`` (unit, receiver to satellite). For a plane
 with unit normal ``n`` facing the receiver at height ``h`` above it, the reflected signal

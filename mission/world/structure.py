@@ -119,11 +119,6 @@ class Structure:
             inside |= self._solid_file_mesh.contains(points)
         return inside
 
-    @property
-    def bounds(self) -> np.ndarray:
-        """(2, 3) array: min and max corner of the structure."""
-        return np.array([self.vertices.min(axis=0), self.vertices.max(axis=0)])
-
 
 def build_structure(settings: StructureSettings, source: str = "") -> Structure:
     """Build the structure's mesh from its primitives and mesh file."""

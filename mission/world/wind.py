@@ -1,4 +1,4 @@
-"""The wind a flying vehicle feels around the bridge (issue 31): a mean wind, shaped by the
+"""The wind a flying vehicle feels around the bridge: a mean wind, shaped by the
 structure, with Dryden turbulence.
 
 **The field** (:class:`WindField`) is crude and says so: no flow is solved. A box of the
@@ -84,10 +84,6 @@ class WindField:
             if _horizontal_gap(pier, x, y) <= s.edge_width_m and z <= pier.max_m[2]:
                 return s.edge_gain
         return 1.0
-
-    def mean_at(self, point: np.ndarray) -> np.ndarray:
-        """The mean wind at ``point``."""
-        return self.factor(point) * self.free_stream
 
 
 def _expm(matrix: np.ndarray) -> np.ndarray:

@@ -12,8 +12,9 @@ import pytest
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.analysis.metrics import read_tlog, read_tlog_with_mavutil
+from mission.analysis.metrics import read_tlog
 from mission.config.scenario import load_scenario
+from tests.tlog_reference import read_tlog_with_mavutil
 
 
 def _packet(system: int, message) -> bytes:

@@ -14,9 +14,10 @@ import pytest
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from mission.analysis.metrics import read_tlog, read_tlog_with_mavutil, trace_metrics
+from mission.analysis.metrics import read_tlog, trace_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate
 from mission.world.frames import GeodeticFrame
+from tests.tlog_reference import read_tlog_with_mavutil
 from vehicle_sim import telemetry
 
 OFFSETS = {1: 3.2, 2: 11.7}  # each vehicle's clock minus the ground station's (s)

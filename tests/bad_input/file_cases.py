@@ -64,7 +64,7 @@ FILE_CASES = [
         lambda t: [*RUN, str(scenario_file(t, NEW_PATH))],
         ["work.waypoints", "task.work_waypoints_m 2", "plan it again"],
     ),
-    # --- a support's own inspection waypoints (issue 33) ---------------------------------
+    # --- a support's own inspection waypoints ---------------------------------
     (
         "yaml-inspection-inside-the-structure",
         lambda t: [*RUN, str(scenario_file(t, INSPECTIONS % ("support-1", "[0.0, 0.0, 8.5]")))],
@@ -146,7 +146,7 @@ FILE_CASES = [
         lambda t: [*RUN, str(scenario_file(t, "integrity: {motion_sigma_m: .inf}\n"))],
         ["bad.yaml", "integrity.motion_sigma_m", "finite"],
     ),
-    # --- a body, loop or wind the model cannot fly or integrate (issue 46) ---------------
+    # --- a body, loop or wind the model cannot fly or integrate ---------------
     *[
         (
             f"yaml-flight-{case}",

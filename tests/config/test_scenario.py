@@ -158,7 +158,7 @@ BAD_INPUTS = [
         "vehicle.autopilot.tilt_max_deg",
         "[5, 90) degrees",
     ),
-    # settings in range alone and then fatal or meaningless in flight (issue 46's red team)
+    # settings in range alone and then fatal or meaningless in flight (found by a red team)
     (
         "tilt of 1e-9 degrees",
         "vehicle: {autopilot: {tilt_max_deg: 1.0e-9}}\n",

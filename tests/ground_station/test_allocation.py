@@ -1,4 +1,4 @@
-"""Task allocation (issue 33) on a scripted work path over a hand-made map G: open sky where
+"""Task allocation on a scripted work path over a hand-made map G: open sky where
 x < 0, shadow where x >= 0. The work UAV flies 19 m of open sky, zig-zags along the boundary
 (its own fix flips with every leg), flies 16 m of open sky (53 s: between the recall and the
 release look-ahead), crosses a shadow, and ends in the open. The supports fly what they are

@@ -98,8 +98,8 @@ def test_a_plan_does_not_depend_on_the_solves_before_it(along_world, local):
 
 @pytest.mark.parametrize("solver", ["ipopt", "fatrop"])
 def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkeypatch, solver):
-    """Without a C compiler the NLP is interpreted; with ``mpc_solver: ipopt`` (what MODEL.md
-    names) IPOPT solves it. Either way the plans are the compiled fatrop's: fatrop runs
+    """Without a C compiler the NLP is interpreted; with ``mpc_solver: ipopt`` IPOPT
+    solves it. Either way the plans are the compiled fatrop's: fatrop runs
     IPOPT's algorithm, and the interpreter evaluates the same functions."""
     from dataclasses import replace as replaced
 

@@ -1,4 +1,4 @@
-"""The piers scenario (issue 33): an inspection that leaves the deck's shadow. Its shipped plan
+"""The piers scenario: an inspection that leaves the deck's shadow. Its shipped plan
 keeps the run's margins (that the planner reproduces its plans byte for byte is Along's test);
 its work path lies partly in the open, where the station's sky model expects a fix, and partly
 in the shadow, where it does not; each support has inspection waypoints of its own, clear of

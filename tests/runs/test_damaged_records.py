@@ -49,7 +49,7 @@ DAMAGE = {
     "time-1e300": (_replace_field("t", 1e300), "t: expected a time"),
     "xhat-a-string": (_replace_field("xhat", "here"), "xhat: expected 3 finite numbers"),
     "roles-a-number": (_replace_field("roles", 5), "roles: expected an object"),
-    # of another run, or edited (issue 46's red team)
+    # of another run, or edited (found by a red team)
     "nested-deep": (_foreign(b"[" * 200_000 + b"]" * 200_000), "nested too deeply"),
     "a-support-not-flown": (
         _replace_field("consistent", ["support-9"]),

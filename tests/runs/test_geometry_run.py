@@ -1,4 +1,4 @@
-"""A run whose multipath comes from geometry (issue 47), real processes end to end: the
+"""A run whose multipath comes from geometry, real processes end to end: the
 supports' receivers report float fixes where they track a reflection, and the summary's true
 errors equal the tlog's fixes against its truth (read by pymavlink)."""
 

@@ -1,4 +1,4 @@
-"""Dynamic roles in a real run (issue 33), the piers scenario to the end: the ground station
+"""Dynamic roles in a real run, the piers scenario to the end: the ground station
 uses the work UAV's own fix in the open (at the piers and the deck's edges), each where G
 expects at most 0.3 m, and the summary counts the verdicts; it releases supports to their
 inspections while the path ahead is open, never has one away from the formation (inspecting,

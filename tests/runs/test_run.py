@@ -190,8 +190,9 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     assert len(sent) == 4 * summary["control_cycles"]
 
     # The fast tlog reader (skips undecoded kinds) equals pymavlink's, plain and signed.
-    from mission.analysis.metrics import read_tlog, read_tlog_with_mavutil
+    from mission.analysis.metrics import read_tlog
     from mission.config.scenario import load_scenario
+    from tests.tlog_reference import read_tlog_with_mavutil
 
     loaded = load_scenario(str(scenario))
     for run in ("a", "b"):

@@ -18,7 +18,7 @@ from mission.analysis.records_file import read_records
 from mission.config.scenario import load_scenario
 from mission.world.model import World
 from tests.margins_check import independent_truth, run_margins
-from tests.processes import mission
+from tests.processes import EXIT_NOT_COMPLETED, mission
 
 pytestmark = pytest.mark.slow  # every test here starts processes
 
@@ -63,7 +63,7 @@ def crashed(tmp_path_factory) -> tuple[Path, Path]:
     tmp = tmp_path_factory.mktemp("crash")
     out, scenario = tmp / "run", _paper_form(tmp, True)
     result = mission("run", str(scenario), "--out", str(out))
-    assert result.returncode == 0, result.stderr
+    assert result.returncode == EXIT_NOT_COMPLETED, result.stderr  # flown, not completed
     assert "STOPPED: support-1 crashed" in result.stdout
     return out, scenario
 

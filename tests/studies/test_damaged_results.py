@@ -52,7 +52,7 @@ DAMAGE = {
     "empty": (lambda d: b"", "is empty"),
     "unknown-point": (_cell("point", "7"), "point 7"),
     "a-row-twice": (lambda d: d + d.split(b"\n", 2)[1] + b"\n", "a second time"),
-    # issue 46's red team
+    # found by a red team
     "a-nul-byte": (_cell("run_key", "ab\0cd"), "line 3: holds a NUL byte"),
     "a-column-twice": (
         lambda d: d.replace(b"completion_time_s", b"control_cycles", 1),

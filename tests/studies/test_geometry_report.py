@@ -1,4 +1,4 @@
-"""G against the true error field (issue 47) on hand-made maps, and the study's tables from
+"""G against the true error field on hand-made maps, and the study's tables from
 hand-made study folders."""
 
 from __future__ import annotations

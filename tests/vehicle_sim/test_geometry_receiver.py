@@ -1,4 +1,4 @@
-"""A vehicle's GPS_RAW_INT where the multipath comes from geometry (issue 47): what such a
+"""A vehicle's GPS_RAW_INT where the multipath comes from geometry: what such a
 receiver reports (the satellites it used, its solution's fix type, accuracy from the geometry
 it used), and never its bias; SIM_MP_SCALE scales the bias."""
 

@@ -1,4 +1,4 @@
-"""The true GNSS error field beside G in the 3-D view (issue 47): recorded where the multipath
+"""The true GNSS error field beside G in the 3-D view: recorded where the multipath
 comes from geometry, each voxel's value the receiver's error at its centre, read back with
 Rerun's own reader; absent with zones."""
 

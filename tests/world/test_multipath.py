@@ -1,4 +1,4 @@
-"""Multipath from geometry (issue 47) against closed forms: excess paths off the ground and a
+"""Multipath from geometry against closed forms: excess paths off the ground and a
 wall, reflections that must not exist, the receiver's least squares, the code-tracking
 envelope, and the open sky where nothing reflects within a chip."""
 
