@@ -12,7 +12,7 @@ from pymavlink import mavutil
 
 from mission.config.scenario import load_scenario
 from mission.world.frames import GeodeticFrame
-from tests.processes import mission
+from tests.processes import EXIT_NOT_COMPLETED, mission
 
 pytestmark = pytest.mark.slow  # starts a run
 
@@ -28,7 +28,7 @@ def test_a_geometry_run_reports_float_fixes_and_their_true_errors(tmp_path):
     scenario = tmp_path / "short-river.yaml"
     scenario.write_text(SHORT_RIVER)
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
-    assert result.returncode == 0, result.stderr
+    assert result.returncode == EXIT_NOT_COMPLETED, result.stderr
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["gnss_multipath"] == "geometry"
     frame = GeodeticFrame(load_scenario(str(scenario)).world.anchor)

@@ -12,7 +12,7 @@ import pytest
 from pymavlink import mavutil
 
 from mission.link.statustext import StatusChunks
-from tests.processes import mission
+from tests.processes import EXIT_NOT_COMPLETED, mission
 from tests.viewer.rrd import read_rrd
 
 pytestmark = pytest.mark.slow  # starts a run
@@ -44,7 +44,7 @@ def glitched(tmp_path_factory):
     scenario = tmp_path / "glitched.yaml"
     scenario.write_text(GLITCHED)
     result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
-    assert result.returncode == 0, result.stderr
+    assert result.returncode == EXIT_NOT_COMPLETED, result.stderr
     return tmp_path
 
 

@@ -120,7 +120,7 @@ def test_a_blind_work_uav_holds_where_it_is(tmp_path):
     path = tmp_path / "blind.yaml"
     path.write_text(BLIND)
     result = mission("run", str(path), "--out", str(tmp_path / "run"))
-    assert result.returncode == 0, result.stderr
+    assert result.returncode == EXIT_NOT_COMPLETED, result.stderr
     records = [
         json.loads(line) for line in (tmp_path / "run/records.jsonl").read_text().splitlines()
     ]
