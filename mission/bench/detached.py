@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.cycle import CycleOutput, complete_cycle, control_cycle
-from ground_station.localize import SupportReport
+from ground_station.control.cycle import CycleOutput, complete_cycle, control_cycle
+from ground_station.control.run_context import build_run_context
+from ground_station.estimation.localize import SupportReport
 from ground_station.roles.allocation import inspections_left
-from ground_station.run_context import build_run_context
 from mission.world.model import World
 from vehicle_sim.kinematics import Kinematics
 

@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from ground_station.plan import plan, work_must_wait
-from ground_station.run_context import build_run_context
+from ground_station.control.plan import plan, work_must_wait
+from ground_station.control.run_context import build_run_context
+from ground_station.control.work_mpc import predict_work
 from ground_station.support_mpc.margins import SLOTS, Margins
 from ground_station.support_mpc.mpc import CONVERGED, SupportMpc
 from ground_station.support_mpc.nlp import SOFT
-from ground_station.work_mpc import predict_work
 from mission.config.scenario import load_scenario
 from mission.link.plan_files import read_plan
 from mission.world.model import KnownWorld, World

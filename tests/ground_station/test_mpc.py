@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground_station.gnss_map import LocalizabilityMap, hermite_zero_slope
+from ground_station.control.work_mpc import predict_work
+from ground_station.estimation.gnss_map import LocalizabilityMap, hermite_zero_slope
 from ground_station.support_mpc.mpc import CONVERGED, SupportMpc
 from ground_station.support_mpc.nlp_cache import c_compiler
-from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
 
 

@@ -10,9 +10,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from ground_station.control.work_mpc import predict_work
 from ground_station.support_mpc.mpc import CONVERGED, PlanRequest, SupportMpc, SupportPlan
 from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
-from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
 
 

@@ -14,7 +14,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ground_station.fusion import SupportMeasurement
+from ground_station.estimation.fusion import SupportMeasurement
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import KnownWorld
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from mission.config.settings import FusionSettings
 
 
@@ -119,7 +119,7 @@ def fuse(
     predicted = state.xhat + state.last_work_command
     fusion = selective_fusion(supports, predicted, settings, rng)
     # Blind, the work UAV's estimate is dead-reckoned: where its last command took it (the
-    # position its autopilot believes, which it then holds: ground_station.plan).
+    # position its autopilot believes, which it then holds: ground_station.control.plan).
     state.xhat = predicted if fusion.xhat is None else fusion.xhat
     betas: dict[str, float | None] = {}
     for support in supports:
