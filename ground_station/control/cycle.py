@@ -173,7 +173,11 @@ def complete_cycle(
 
 
 def run_cycle(
-    state: StationState, reports: Sequence[SupportReport], context: RunContext
+    state: StationState,
+    reports: Sequence[SupportReport],
+    context: RunContext,
+    work_fix: np.ndarray | None = None,
 ) -> CycleOutput:
-    """A whole cycle with nothing sent in between (the detached run, tests)."""
-    return complete_cycle(state, control_cycle(state, reports, context), context)
+    """A whole cycle with nothing sent in between (the detached run of
+    :mod:`mission.bench.detached`, tests)."""
+    return complete_cycle(state, control_cycle(state, reports, context, work_fix), context)
