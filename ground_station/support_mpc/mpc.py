@@ -3,9 +3,10 @@ with casadi + fatrop (or IPOPT), built once per run, for any support with its ow
 
 Observability (range and line of sight between V^(w)_u and v_u) is not differentiable: it is
 evaluated on the initial guess (the previous solution shifted by one step), held fixed during
-the solve, and the problem is solved once more if the solution's flags differ (MODEL.md),
-with a step blocked at either held blocked: taking the solution's flags alone flip-flops
-between two paths, each blocked where the other's flags say it is not.
+the solve, and the problem is solved once more if the solution's flags differ
+(docs/ground-station.md, "The support MPC"), with a step blocked at either held blocked:
+taking the solution's flags alone flip-flops between two paths, each blocked where the
+other's flags say it is not.
 
 Each solve is the minimum over the terminal link's two branches, near and far, each solved
 with its margins hard or soft (:mod:`ground_station.support_mpc.branches`).
