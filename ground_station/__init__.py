@@ -1,1 +1,1 @@
-"""The ground station (sees no zones nor truth). Imports: config, world, link, procs, maths."""
+"""The ground station (sees no zones nor truth). Imports: config, world, link, procs."""

@@ -10,9 +10,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from ground_station.cycle import CycleOutput
-from ground_station.gnss_map import LocalizabilityMap
-from ground_station.state import StationState
+from ground_station.control.cycle import CycleOutput
+from ground_station.estimation.gnss_map import LocalizabilityMap
+from ground_station.state.station_state import StationState
 from mission.procs.atomic import write_text_atomically
 
 SNAPSHOT_EVERY = 20  # cycles between snapshots of G

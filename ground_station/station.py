@@ -5,7 +5,8 @@ Its pieces: the links to the vehicles (:mod:`~ground_station.links.vehicle_links
 clock (:mod:`~ground_station.links.clock`), the messages it sends
 (:mod:`~ground_station.links.outgoing`), what it writes (:mod:`~ground_station.records`,
 :mod:`~ground_station.links.tlog`), the run's context built once (the map G, the support MPC:
-:mod:`~ground_station.run_context`) and the cycle itself (:mod:`~ground_station.cycle`).
+:mod:`~ground_station.control.run_context`) and the cycle itself
+(:mod:`~ground_station.control.cycle`).
 """
 
 from __future__ import annotations
@@ -18,7 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from ground_station.cycle import CycleDecision, CycleOutput, complete_cycle, control_cycle
+from ground_station.control.cycle import CycleDecision, CycleOutput, complete_cycle, control_cycle
+from ground_station.control.run_context import RunContext, build_run_context, require_known_world
+from ground_station.estimation.localize import SupportReport, gnss_fix, reports_from_messages
 from ground_station.links.clock import LockstepTiming, PendingStep, StationClock, await_step
 from ground_station.links.outgoing import (
     mission_set_current,
@@ -27,12 +30,10 @@ from ground_station.links.outgoing import (
 )
 from ground_station.links.tlog import TlogWriter
 from ground_station.links.vehicle_links import VehicleLinks
-from ground_station.localize import SupportReport, gnss_fix, reports_from_messages
 from ground_station.preflight import arm_all, connect, upload_missions
 from ground_station.records import SNAPSHOT_EVERY, GSnapshots, RunRecords
 from ground_station.roles.allocation import inspections_left
-from ground_station.run_context import RunContext, build_run_context, require_known_world
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from ground_station.support_mpc.sharing import MpcHelper
 from mission.link.impairment import LinkSettings
 from mission.link.mavlink_udp import Address

@@ -30,7 +30,13 @@ SHORT_NAMES = {  # the names the docstrings use for the project's packages
     "studies": "mission.studies",
     "viewer": "mission.viewer",
     "ground_station": "ground_station",
+    "state": "ground_station.state",
+    "estimation": "ground_station.estimation",
+    "integrity": "ground_station.integrity",
     "support_mpc": "ground_station.support_mpc",
+    "roles": "ground_station.roles",
+    "control": "ground_station.control",
+    "links": "ground_station.links",
     "vehicle_sim": "vehicle_sim",
 }
 
@@ -136,6 +142,33 @@ def test_layers_import_only_what_their_package_allows():
             if allowed is not None and not inside and theirs not in allowed:
                 forbidden.append(f"{module} -> {target}")
     assert not forbidden, "imports against the layering:\n" + "\n".join(sorted(forbidden))
+
+
+def test_a_subpackage_never_imports_its_parents_modules():
+    """Layers go down: a package's own modules use its subpackages, never the other way."""
+    names = set(packages())
+    upward = []
+    for module, targets in import_graph().items():
+        mine = owner(module, names)
+        for target in targets:
+            theirs = owner(target, names)
+            if mine.startswith(theirs + "."):
+                upward.append(f"{module} -> {target}")
+    assert not upward, "subpackages importing their parents:\n" + "\n".join(sorted(upward))
+
+
+def package_graph() -> dict[str, set[str]]:
+    """Which packages each package's modules import (its own left out)."""
+    names = set(packages())
+    graph: dict[str, set[str]] = {name: set() for name in names}
+    for module, targets in import_graph().items():
+        mine = owner(module, names)
+        graph[mine] |= {owner(target, names) for target in targets} - {mine}
+    return graph
+
+
+def test_no_import_circle_between_packages():
+    assert circles(package_graph()) == []
 
 
 def test_the_processes_never_import_each_other_and_the_floor_never_imports_the_roof():

@@ -1,1 +1,1 @@
-"""Integrity: each fix tested, excluded, restored. Imports: config, maths, ground_station."""
+"""Integrity: each fix tested, excluded, restored. Imports: config, maths, state, estimation."""

@@ -11,12 +11,12 @@ from typing import Protocol
 
 import numpy as np
 
-from ground_station.fusion import FusionResult, SupportMeasurement
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.fusion import FusionResult, SupportMeasurement
+from ground_station.estimation.gnss_map import LocalizabilityMap
 from ground_station.integrity.consistency import Formation
 from ground_station.integrity.protection import detectable_bias, fault_shift
 from ground_station.integrity.verdict import Event, Verdict, Watch
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from mission.config.integrity_settings import IntegritySettings
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ground_station.fusion import SupportMeasurement
+from ground_station.estimation.fusion import SupportMeasurement
 from ground_station.integrity.small import inverse3, quadratic3
 
 

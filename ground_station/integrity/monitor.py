@@ -26,15 +26,15 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ground_station.fusion import FusionResult, SupportMeasurement
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.fusion import FusionResult, SupportMeasurement
+from ground_station.estimation.gnss_map import LocalizabilityMap
 from ground_station.integrity.aftermath import learn_excluded, settle
 from ground_station.integrity.consistency import Formation, Innovation, motion_innovation
 from ground_station.integrity.protection import (
     detectable_bias,
 )
 from ground_station.integrity.verdict import Event, Verdict, Watch
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from mission.config.integrity_settings import IntegritySettings
 from mission.maths.chi_square import detectable_noncentrality, gate
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ground_station.gnss_map import Change
+from ground_station.estimation.gnss_map import Change
 
 
 @dataclass

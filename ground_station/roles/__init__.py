@@ -1,1 +1,1 @@
-"""Who flies in the formation, who inspects. Imports: config, world, ground_station, support_mpc."""
+"""Who is in the formation, who inspects. Imports: config, world, state, estimation, support_mpc."""

@@ -39,20 +39,23 @@ straight way back cutting the margin.
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import numpy as np
 
-from ground_station.roles.assignment import (
+from ground_station.estimation.gnss_map import LocalizabilityMap
+from ground_station.roles.lookahead import clear_ahead_s, points_along
+from ground_station.state.assignment import (
     FORMATION,
     INSPECTING,
     RETURNING,
     Allocation,
     SupportRole,
 )
-from ground_station.roles.lookahead import clear_ahead_s, points_along
-from ground_station.run_context import RunContext
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from ground_station.support_mpc.mpc import SupportPlan
+from mission.config.settings import Scenario
+from mission.world.routes import RouteMap
 
 CORNER_TOL_M = 0.3  # a route's corner (not an inspection waypoint) is passed this close
 REROUTE_AFTER = 10  # cycles held giving way before a route round the others is sought
@@ -60,7 +63,20 @@ LOOK_AHEAD_FACTOR = 2.0  # the path is looked at this many release_clear_s ahead
 TRANSIT_M = 4.0  # a formation support farther from its waypoint, behind the structure, is routed
 
 
-def inspections_left(allocation: Allocation, context: RunContext) -> bool:
+class RoleContext(Protocol):
+    """What the task allocation reads of the run: the scenario, the planned waypoints, the map
+    G, the supports' inspections and the routes to fly them (None without inspections). The
+    control cycle's context has them all."""
+
+    scenario: Scenario
+    work_waypoints: np.ndarray
+    support_waypoints: dict[str, np.ndarray]
+    g: LocalizabilityMap
+    inspections: dict[str, np.ndarray]
+    routes: RouteMap | None
+
+
+def inspections_left(allocation: Allocation, context: RoleContext) -> bool:
     """Whether a support has inspection waypoints it has not reached."""
     return any(
         allocation.supports.get(n, SupportRole()).next_inspection < len(points)
@@ -68,7 +84,7 @@ def inspections_left(allocation: Allocation, context: RunContext) -> bool:
     )
 
 
-def allocate(state: StationState, context: RunContext, allocation: Allocation) -> None:
+def allocate(state: StationState, context: RoleContext, allocation: Allocation) -> None:
     """This cycle's roles (``allocation`` updated in place): progress along the routes, then
     release and recall. Without inspections in the scenario nothing happens."""
     if not context.inspections:
@@ -99,7 +115,7 @@ def allocate(state: StationState, context: RunContext, allocation: Allocation) -
 
 
 def _send_round_the_structure(
-    state: StationState, context: RunContext, allocation: Allocation
+    state: StationState, context: RoleContext, allocation: Allocation
 ) -> None:
     """A formation support more than ``TRANSIT_M`` from its formation waypoint with the
     structure in the straight way (within the clearance margin of it) is routed there
@@ -117,7 +133,7 @@ def _send_round_the_structure(
             _set(allocation, name, RETURNING, _routed(state, context, name, home))
 
 
-def _release(state: StationState, context: RunContext, allocation: Allocation) -> None:
+def _release(state: StationState, context: RoleContext, allocation: Allocation) -> None:
     keep = 0 if state.completed else context.scenario.roles.keep_in_formation
     limit = len(state.yhat) - keep
     out = sum(1 for s in allocation.supports.values() if s.role == INSPECTING)
@@ -138,7 +154,7 @@ def _release(state: StationState, context: RunContext, allocation: Allocation) -
         _set(allocation, name, INSPECTING, _route_to_inspection(state, context, allocation, name))
 
 
-def _progress(state: StationState, context: RunContext, allocation: Allocation) -> None:
+def _progress(state: StationState, context: RoleContext, allocation: Allocation) -> None:
     """Corners passed, inspection waypoints reached, returns completed."""
     tol = context.scenario.roles.inspection_tol_m
     for name, support in allocation.supports.items():
@@ -172,7 +188,7 @@ def _progress(state: StationState, context: RunContext, allocation: Allocation) 
                 state.warm.pop(name, None)  # its MPC starts afresh from where it is
 
 
-def _mpc_can_take(context: RunContext, yhat: np.ndarray, home: np.ndarray) -> bool:
+def _mpc_can_take(context: RoleContext, yhat: np.ndarray, home: np.ndarray) -> bool:
     """Within ``TRANSIT_M`` of its formation waypoint with no structure in the straight way
     (the formation's other supports, which a routed support gives way to, can keep it
     metres from its waypoint)."""
@@ -182,7 +198,7 @@ def _mpc_can_take(context: RunContext, yhat: np.ndarray, home: np.ndarray) -> bo
     return not context.routes.structure_between(yhat, home, _transit_margin(context))
 
 
-def _transit_margin(context: RunContext) -> float:
+def _transit_margin(context: RoleContext) -> float:
     control, vehicle = context.scenario.control, context.scenario.vehicle
     return max(control.clearance_m, vehicle.radius_m)
 
@@ -194,7 +210,7 @@ def _set(allocation: Allocation, name: str, role: str, route: np.ndarray | None)
     support.role, support.route, support.held = role, route, 0
 
 
-def _formation_waypoint(state: StationState, context: RunContext, name: str) -> np.ndarray:
+def _formation_waypoint(state: StationState, context: RoleContext, name: str) -> np.ndarray:
     waypoints = context.support_waypoints[name]
     return waypoints[min(state.k, len(waypoints) - 1)]
 
@@ -204,11 +220,11 @@ def _route_to_inspection(state, context, allocation, name) -> np.ndarray:
     return _routed(state, context, name, goal)
 
 
-def _route_home(state: StationState, context: RunContext, name: str) -> np.ndarray:
+def _route_home(state: StationState, context: RoleContext, name: str) -> np.ndarray:
     return _routed(state, context, name, _formation_waypoint(state, context, name))
 
 
-def _routed(state: StationState, context: RunContext, name: str, goal: np.ndarray) -> np.ndarray:
+def _routed(state: StationState, context: RoleContext, name: str, goal: np.ndarray) -> np.ndarray:
     """The corners after the support's estimate of a route to ``goal`` that keeps off the
     other UAVs' estimates by the separation; where they close every way, one that does not
     (it gives way as it goes); where the structure does, none: it holds."""
@@ -221,7 +237,7 @@ def _routed(state: StationState, context: RunContext, name: str, goal: np.ndarra
     return np.array([start]) if route is None else route[1:]
 
 
-def _crowding_m(context: RunContext) -> float:
+def _crowding_m(context: RoleContext) -> float:
     """How close to another UAV's estimate a routed support does not go: the separation
     widened by two estimates' allowance (0: no separation margin)."""
     control = context.scenario.control
@@ -230,7 +246,7 @@ def _crowding_m(context: RunContext) -> float:
     return control.min_separation_m + 2 * control.estimate_allowance_m
 
 
-def routed_plans(state: StationState, context: RunContext, allocation: Allocation):
+def routed_plans(state: StationState, context: RoleContext, allocation: Allocation):
     """{name: plan} of every support off the formation: its route's next steps (the first is
     its command), or, where that step would crowd another UAV, a step away from it."""
     control = context.scenario.control

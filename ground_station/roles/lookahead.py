@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.gnss_map import LocalizabilityMap
 
 
 def path_ahead(xhat: np.ndarray, k: int, waypoints: np.ndarray, spacing_m: float, length_m: float):

@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ground_station.fusion import FusionResult
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.fusion import FusionResult
+from ground_station.estimation.gnss_map import LocalizabilityMap
 from mission.config.role_settings import RoleSettings
 from mission.world.model import KnownWorld
 

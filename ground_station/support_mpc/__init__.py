@@ -1,1 +1,1 @@
-"""The support MPC: its NLP, solvers and margins. Imports: config, world, procs, ground_station."""
+"""The support MPC: its NLP, solvers and margins. Imports: config, world, procs, estimation."""

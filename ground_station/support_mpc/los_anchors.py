@@ -13,7 +13,7 @@ import itertools
 
 import numpy as np
 
-from ground_station.gnss_map import hermite_zero_slope
+from ground_station.estimation.gnss_map import hermite_zero_slope
 from mission.config.settings import ControlSettings
 from mission.world.camera import CameraModel
 from mission.world.grid import VoxelGrid

@@ -23,7 +23,7 @@ Each step is also bounded hard by d_max (the vehicle cannot fly faster), where x
 w_interval d^2; the terminal link keeps the jump at d_max, which the solver sees as two smooth
 NLPs, *near* (|w - v_U| <= d_max, weight w_interval) and *far* (weight w_penalty): see
 :mod:`ground_station.support_mpc.mpc`. G_s enters as the explicit eight-corner sum of
-:func:`~ground_station.gnss_map.casadi_hermite` over a window of voxels around yhat_n,
+:func:`~ground_station.estimation.gnss_map.casadi_hermite` over a window of voxels around yhat_n,
 so the solver gets exact second derivatives.
 """
 
@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ground_station.gnss_map import inlined_hermite
+from ground_station.estimation.gnss_map import inlined_hermite
 from ground_station.support_mpc.casadi_buffer import BufferedFunction
 from ground_station.support_mpc.nlp_cache import NlpBuild, compiled_libraries
 from mission.config.settings import ControlSettings

@@ -6,7 +6,7 @@ process each); later runs load the cached libraries and build nothing.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 
 import casadi as ca
@@ -19,13 +19,6 @@ __all__ = ["COMPILED", "COMPILING", "FunctionBuild", "NlpBuild", "c_compiler"]
 SUPPORT_MPC = casadi_cache.Compiling("ground station", "the support MPC", "support_mpc")
 COMPILING = SUPPORT_MPC.starting  # what `mission run` shows of a first run's wait
 COMPILED = SUPPORT_MPC.done
-
-
-def compiled_nlps(
-    builds: list[NlpBuild | FunctionBuild], fallback_dir: Callable[[], str]
-) -> list[str | None]:
-    """Each build's library (None without a C compiler): :func:`casadi_cache.compiled_builds`."""
-    return casadi_cache.compiled_builds(builds, fallback_dir, SUPPORT_MPC)
 
 
 @contextmanager

@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.cycle import CycleOutput, complete_cycle, control_cycle
-from ground_station.localize import SupportReport
+from ground_station.control.cycle import CycleOutput, run_cycle
+from ground_station.control.run_context import build_run_context
+from ground_station.estimation.localize import SupportReport
 from ground_station.roles.allocation import inspections_left
-from ground_station.run_context import build_run_context
 from mission.world.model import World
 from vehicle_sim.kinematics import Kinematics
 
@@ -77,7 +77,7 @@ def detached_cycles(
         if scenario.roles.policy == "dynamic":
             fix = world.gnss_fix(work_truth, own_rng)
             work_fix = fix.position_m if fix.has_fix else None
-        output = complete_cycle(state, control_cycle(state, reports, context, work_fix), context)
+        output = run_cycle(state, reports, context, work_fix)
         yield output, work_truth.copy(), state.completed
         if not output.blind:  # blind, the work UAV holds on its own dead reckoning
             vehicles["work"].set_estimate(state.xhat)

@@ -198,8 +198,8 @@ def _interpreted_over_compiled(world, plan, indices=range(2, 12)) -> float:
     one's, on the three supports' problems at ten waypoints (the same plans either way)."""
     import numpy as np
 
+    from ground_station.control.work_mpc import predict_work
     from ground_station.support_mpc.mpc import SupportMpc
-    from ground_station.work_mpc import predict_work
 
     control, grid, sigma0 = world.scenario.control, world.map_grid(), world.sigma0_map().sigma_m
     compiled = SupportMpc(control, grid, world.camera, sigma0)
@@ -244,8 +244,8 @@ def _scipy_over_casadi_once(world, plan, mpc, g, i: int) -> float | None:
     import numpy as np
     from scipy.optimize import minimize
 
+    from ground_station.control.work_mpc import predict_work
     from ground_station.support_mpc.cost_check import support_cost_numpy
-    from ground_station.work_mpc import predict_work
 
     control, grid = world.scenario.control, world.map_grid()
     u, waypoints = control.horizon_steps, plan.supports[0]

@@ -13,10 +13,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.gnss_map import LocalizabilityMap
 from ground_station.roles.allocation import allocate, routed_plans
-from ground_station.roles.assignment import INSPECTING, SupportRole
-from ground_station.state import StationState
+from ground_station.state.assignment import INSPECTING, SupportRole
+from ground_station.state.station_state import StationState
 from mission.config.scenario import load_scenario
 from mission.link.plan_files import read_vehicle_waypoints
 from mission.world.model import KnownWorld

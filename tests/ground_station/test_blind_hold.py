@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground_station.cycle import run_cycle
-from ground_station.localize import SupportReport
-from ground_station.run_context import build_run_context
+from ground_station.control.cycle import run_cycle
+from ground_station.control.run_context import build_run_context
+from ground_station.estimation.localize import SupportReport
 from mission.link.plan_files import read_plan
 from mission.world.model import KnownWorld
 

@@ -9,9 +9,9 @@ import copy
 
 import numpy as np
 
-from ground_station.cycle import control_cycle
-from ground_station.localize import IMPLAUSIBLE_FIX_M, SupportReport
-from ground_station.run_context import build_run_context
+from ground_station.control.cycle import control_cycle
+from ground_station.control.run_context import build_run_context
+from ground_station.estimation.localize import IMPLAUSIBLE_FIX_M, SupportReport
 from mission.link.plan_files import read_plan
 
 

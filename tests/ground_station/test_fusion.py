@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.stats import multivariate_normal, pearsonr
 
-from ground_station.fusion import (
+from ground_station.estimation.fusion import (
     FusionResult,
     LogDensity,
     SupportMeasurement,
@@ -188,7 +188,7 @@ def test_a_cycles_covariances_in_one_batch_equal_one_at_a_time(along_world, plan
     """localize batches Sigma_GNSS and Sigma_r over the supports: the numbers
     are those of each support alone, bit for bit (with a support lacking an observation and
     one lacking a fix among them)."""
-    from ground_station.localize import SupportReport, localize
+    from ground_station.estimation.localize import SupportReport, localize
 
     known = along_world.known()
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from ground_station.fusion import SupportMeasurement
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.fusion import SupportMeasurement
+from ground_station.estimation.gnss_map import LocalizabilityMap
 from ground_station.integrity.monitor import IntegrityMonitor
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from ground_station.support_mpc.margins import widened
 from mission.config.settings import MapSettings
 from mission.maths.chi_square import (
@@ -210,7 +210,7 @@ def test_a_bias_that_follows_its_support_is_its_receivers_and_g_forgets_it(along
 
 
 def _blind():
-    from ground_station.fusion import FusionResult
+    from ground_station.estimation.fusion import FusionResult
 
     return FusionResult(None, (), (), False, np.zeros((0, 0)), ())
 

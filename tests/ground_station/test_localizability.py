@@ -9,7 +9,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ground_station.gnss_map import (
+from ground_station.estimation.gnss_map import (
     LocalizabilityMap,
     casadi_hermite,
     hermite_zero_slope,

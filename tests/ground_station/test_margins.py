@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 import trimesh
 
-from ground_station.plan import plan, work_must_wait
-from ground_station.run_context import build_run_context
+from ground_station.control.plan import plan, work_must_wait
+from ground_station.control.run_context import build_run_context
+from ground_station.control.work_mpc import predict_work
+from ground_station.support_mpc.branches import CONVERGED, TerminalBranches
 from ground_station.support_mpc.margins import SLOTS, Margins
-from ground_station.support_mpc.mpc import CONVERGED, SupportMpc
+from ground_station.support_mpc.mpc import SupportMpc
 from ground_station.support_mpc.nlp import SOFT
-from ground_station.work_mpc import predict_work
 from mission.config.scenario import load_scenario
 from mission.link.plan_files import read_plan
 from mission.world.model import KnownWorld, World
@@ -179,13 +180,13 @@ def test_near_is_not_solved_where_far_beats_what_its_slacks_must_cost(worlds, mo
     parked = YHAT + [2.8, 0.0, 0.0]  # support 2, on the terminal waypoint
     request = _beside_the_bridge(safe, mpc, parked, terminal=parked)
     solved = []
-    solve_branch = SupportMpc._solve_branch
+    solve_branch = TerminalBranches._solve_branch
 
     def counted(self, fixed, flags, guess, branch):
         solved.append(branch)
         return solve_branch(self, fixed, flags, guess, branch)
 
-    monkeypatch.setattr(SupportMpc, "_solve_branch", counted)
+    monkeypatch.setattr(TerminalBranches, "_solve_branch", counted)
     kept = mpc.plan(request, safe.camera.observable)
     assert kept.status == CONVERGED and "near" not in solved and "far" in solved
     control = safe.scenario.control
@@ -196,13 +197,13 @@ def test_near_is_not_solved_where_far_beats_what_its_slacks_must_cost(worlds, mo
 def _forms_solved(monkeypatch) -> list[str]:
     """The solver forms (branch, or branch + SOFT) every solve of the test uses, in order."""
     solved: list[str] = []
-    solve_form = SupportMpc._solve_form
+    solve_form = TerminalBranches._solve_form
 
     def counted(self, fixed, flags, guess, branch, form):
         solved.append(form)
         return solve_form(self, fixed, flags, guess, branch, form)
 
-    monkeypatch.setattr(SupportMpc, "_solve_form", counted)
+    monkeypatch.setattr(TerminalBranches, "_solve_form", counted)
     return solved
 
 
@@ -216,7 +217,7 @@ def test_the_hard_form_is_solved_where_the_margins_can_be_kept_and_has_the_soft_
     solved = _forms_solved(monkeypatch)
     kept, _ = _squeezed(safe, mpc)
     assert kept.status == CONVERGED and solved and not any(f.endswith(SOFT) for f in solved)
-    monkeypatch.setattr(SupportMpc, "_may_keep_margins", lambda *arguments: False)
+    monkeypatch.setattr(TerminalBranches, "_may_keep_margins", lambda *arguments: False)
     soft, _ = _squeezed(safe, mpc)
     assert soft.status == CONVERGED and all(f.endswith(SOFT) for f in solved[-2:])
     np.testing.assert_allclose(soft.path, kept.path, atol=5e-3)
@@ -243,7 +244,7 @@ def test_a_failed_hard_solve_falls_back_to_the_soft_form(worlds, monkeypatch):
     safe, _ = worlds
     mpc = _mpc(safe, 3)
     solved = _forms_solved(monkeypatch)
-    solve_form = SupportMpc._solve_form  # the counting one
+    solve_form = TerminalBranches._solve_form  # the counting one
 
     def hard_fails(self, fixed, flags, guess, branch, form):
         path, status, cost = solve_form(self, fixed, flags, guess, branch, form)
@@ -251,7 +252,7 @@ def test_a_failed_hard_solve_falls_back_to_the_soft_form(worlds, monkeypatch):
             (path, "SOLVER_RET_LIMITED", cost) if not form.endswith(SOFT) else (path, status, cost)
         )
 
-    monkeypatch.setattr(SupportMpc, "_solve_form", hard_fails)
+    monkeypatch.setattr(TerminalBranches, "_solve_form", hard_fails)
     planned, _ = _squeezed(safe, mpc)
     assert planned.status == CONVERGED
     assert [f for f in solved if not f.endswith(SOFT)]  # tried hard first

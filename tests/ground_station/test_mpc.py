@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground_station.gnss_map import LocalizabilityMap, hermite_zero_slope
-from ground_station.support_mpc.mpc import CONVERGED, SupportMpc
+from ground_station.control.work_mpc import predict_work
+from ground_station.estimation.gnss_map import LocalizabilityMap, hermite_zero_slope
+from ground_station.support_mpc.branches import CONVERGED
+from ground_station.support_mpc.mpc import SupportMpc
 from ground_station.support_mpc.nlp_cache import c_compiler
-from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
 
 
@@ -167,14 +168,14 @@ def test_the_far_branch_is_skipped_only_where_it_cannot_win(setting, monkeypatch
     g = world.sigma0_map().sigma_m
     work = predict_work(plan.work[3], 4, plan.work, 5, control.d_max_work_m, control.arrival_tol_m)
     calls = []
-    solve_branch = mpc._solve_branch
+    solve_branch = mpc.branches._solve_branch
 
     def spy(fixed, flags, guess, branch):
         result = solve_branch(fixed, flags, guess, branch)
         calls.append((branch, (fixed, flags, guess), result))
         return result
 
-    monkeypatch.setattr(mpc, "_solve_branch", spy)
+    monkeypatch.setattr(mpc.branches, "_solve_branch", spy)
     terminal = plan.supports[0][work.indices[5]]
     away = np.array([1.0, 0.0, 0.0]) * control.d_max_support_m
     starts = [plan.supports[0][3] + o for o in np.random.default_rng(5).uniform(-2, 2, (6, 3))]
@@ -210,12 +211,12 @@ def test_the_far_branch_is_solved_where_it_wins(setting):
     guess = np.linspace(yhat, terminal, horizon + 1)[1:]
     margins = mpc.margins.parameters(guess, yhat, np.zeros((0, horizon, 3)))
     flags = np.concatenate([anchors.ravel(), blocked, corner, window, margins])
-    path, status, cost = mpc._solve_once(fixed, flags, guess)
-    near = mpc._solve_branch(fixed, flags, guess, "near")
+    path, status, cost = mpc.branches.solve(fixed, flags, guess)
+    near = mpc.branches._solve_branch(fixed, flags, guess, "near")
     assert status == CONVERGED
     assert np.linalg.norm(path[-1] - terminal) > d_max
     assert cost < near[2]
-    assert cost == pytest.approx(mpc.cost(fixed, flags, path))
+    assert cost == pytest.approx(mpc.branches.cost(fixed, flags, path))
 
 
 def test_building_the_mpc_leaves_no_files_in_the_working_directory(

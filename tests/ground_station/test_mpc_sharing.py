@@ -10,9 +10,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ground_station.support_mpc.mpc import CONVERGED, PlanRequest, SupportMpc, SupportPlan
+from ground_station.control.work_mpc import predict_work
+from ground_station.support_mpc.branches import CONVERGED
+from ground_station.support_mpc.mpc import PlanRequest, SupportMpc, SupportPlan
 from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
-from ground_station.work_mpc import predict_work
 from mission.link.plan_files import read_plan
 
 
@@ -93,7 +94,7 @@ def test_a_plan_does_not_depend_on_the_solves_before_it(along_world, local):
     backward = [local.mpc.plan(r, local.observable) for r in reversed(requests)][::-1]
     assert all(_same(a, b) for a, b in zip(forward, backward, strict=True))
     assert sum(plan.status == CONVERGED for plan in forward) == len(requests)
-    assert all(np.isfinite(bounds).all() for bounds in local.mpc._upper_bounds.values())
+    assert all(np.isfinite(bounds).all() for bounds in local.mpc.branches.upper_bounds.values())
 
 
 @pytest.mark.parametrize("solver", ["ipopt", "fatrop"])

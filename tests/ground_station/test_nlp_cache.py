@@ -23,12 +23,21 @@ def _tiny_solver():
     return nlp, IPOPT_OPTIONS
 
 
+def _compiled_nlps(builds, fallback_dir):
+    """Each build's library (None without a C compiler), compiled and cached as the support
+    MPC's are, into ``fallback_dir()`` where the cache is not writable."""
+    from ground_station.support_mpc import nlp_cache
+    from mission.procs import casadi_cache
+
+    return casadi_cache.compiled_builds(builds, fallback_dir, nlp_cache.SUPPORT_MPC)
+
+
 def _compiled_one(name, plugin, nlp, options, fallback_dir):
-    """The library of one NLP, as ``compiled_nlps`` makes it."""
+    """The library of one NLP, as ``_compiled_nlps`` makes it."""
     from ground_station.support_mpc import nlp_cache
 
     build = nlp_cache.NlpBuild(name, plugin, nlp, options)
-    return nlp_cache.compiled_nlps([build], fallback_dir)[0]
+    return _compiled_nlps([build], fallback_dir)[0]
 
 
 def test_a_compilation_says_so_and_how_long_it_took_and_a_hit_says_nothing(
@@ -141,10 +150,10 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
     def no_fallback() -> str:
         raise AssertionError("the cache is writable: no fallback directory")
 
-    first = nlp_cache.compiled_nlps(builds(nlp, shifted), no_fallback)
+    first = _compiled_nlps(builds(nlp, shifted), no_fallback)
     assert len(launched) == 2 and all(p.returncode == 0 for p in launched)
     assert None not in first and len(set(first)) == 2
-    again = nlp_cache.compiled_nlps(builds(nlp, scaled, shifted), no_fallback)
+    again = _compiled_nlps(builds(nlp, scaled, shifted), no_fallback)
     assert len(launched) == 3  # only the new one compiled
     assert (again[0], again[2]) == (first[0], first[1]) and again[1] not in first
     cache = tmp_path / "cache" / "bridge-uav-formation"

@@ -12,12 +12,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ground_station.cycle import control_cycle
-from ground_station.fusion import FusionResult, LogDensity
-from ground_station.gnss_map import LocalizabilityMap
-from ground_station.localize import SupportReport
+from ground_station.control.cycle import control_cycle
+from ground_station.control.run_context import build_run_context
+from ground_station.estimation.fusion import FusionResult, LogDensity
+from ground_station.estimation.gnss_map import LocalizabilityMap
+from ground_station.estimation.localize import SupportReport
 from ground_station.roles.own_fix import combined_estimate, judge
-from ground_station.run_context import build_run_context
 from mission.link.plan_files import read_plan
 
 OPEN_SKY = np.array([0.0, -12.0, 7.0])  # 7 m beside the deck's edge, beside no pier

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 from pymavlink import mavutil
 
-from ground_station.cycle import run_cycle
+from ground_station.control.cycle import run_cycle
+from ground_station.control.run_context import build_run_context
+from ground_station.estimation.localize import reports_from_messages
 from ground_station.links.clock import await_step
 from ground_station.links.outgoing import position_target, vision_position_estimate
-from ground_station.localize import reports_from_messages
-from ground_station.run_context import build_run_context
 from ground_station.station import GroundStation, StationConfig
 from mission.config.settings import Zone
 from mission.link.mavlink_udp import MavlinkCodec
@@ -195,8 +195,8 @@ def test_the_ground_station_refuses_a_world_with_zones(along, along_world, tmp_p
 
 @pytest.mark.parametrize("escape_starts", [True, False])
 def test_escape_starts_are_asked_for_where_g_has_risen_unless_switched_off(escape_starts):
-    from ground_station.plan import support_request
-    from ground_station.work_mpc import WorkPrediction
+    from ground_station.control.plan import support_request
+    from ground_station.control.work_mpc import WorkPrediction
     from mission.config.scenario import load_scenario
 
     scenario = load_scenario("along", {"control.escape_starts": escape_starts})

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground_station.plan import plan, solve_supports
-from ground_station.run_context import build_run_context
+from ground_station.control.plan import plan, solve_supports
+from ground_station.control.run_context import build_run_context
 from ground_station.support_mpc.mpc import SupportPlan
 from mission.link.plan_files import read_plan
 

@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ground_station.align import align
+from ground_station.estimation.align import align
+from ground_station.estimation.localize import SupportReport
 from ground_station.links.clock import StationClock
 from ground_station.links.clock_sync import ClockOffsets
 from ground_station.links.tlog import TlogWriter
 from ground_station.links.vehicle_links import MAX_AGE_STEPS, VehicleLinks
-from ground_station.localize import SupportReport
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from mission.link.impairment import LinkSettings
 
 

@@ -79,6 +79,6 @@ def test_the_code_version_follows_the_code_a_run_executes(tmp_path, monkeypatch)
     (copy / "__pycache__" / "x.pyc").parent.mkdir(exist_ok=True)
     (copy / "__pycache__" / "x.pyc").write_bytes(b"cache")
     assert code_version() == before
-    fusion = copy / "fusion.py"
+    fusion = copy / "estimation" / "fusion.py"
     fusion.write_text(fusion.read_text() + "\n# a comment is code too: the digest is of bytes\n")
     assert code_version() != before

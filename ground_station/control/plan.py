@@ -12,12 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.gnss_map import hermite_zero_slope
+from ground_station.control.run_context import RunContext
+from ground_station.control.work_mpc import WorkPrediction, hold_work, predict_work
+from ground_station.estimation.gnss_map import hermite_zero_slope
 from ground_station.roles.allocation import routed_plans
-from ground_station.run_context import RunContext
-from ground_station.state import StationState, reachable
+from ground_station.state.station_state import StationState
 from ground_station.support_mpc.mpc import PlanRequest, SupportPlan
-from ground_station.work_mpc import WorkPrediction, hold_work, predict_work
 
 ESCAPE_MARGIN_M = 0.25  # G_s this far above its start at yhat: try escape starts too
 
@@ -57,6 +57,13 @@ def plan(
     reach = control.s_max_work_m_s * control.t_cont_s
     state.last_work_command = reachable(state.xhat, work.command, reach)
     return FormationPlan(work, tuple(supports))
+
+
+def reachable(start: np.ndarray, target: np.ndarray, reach: float) -> np.ndarray:
+    """The displacement a vehicle makes toward ``target`` in one cycle, at most ``reach``."""
+    move = target - start
+    distance = float(np.linalg.norm(move))
+    return move if distance <= reach else move * (reach / distance)
 
 
 def work_must_wait(state: StationState, command: np.ndarray, context: RunContext) -> bool:

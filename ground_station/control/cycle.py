@@ -1,7 +1,7 @@
 """The control cycle of the paper's Section 4, run every t_cont: five steps, one call each.
 
 1. localize: each support's GNSS fix p_n and camera observation r_n (brought to the cycle's
-   time, :mod:`~ground_station.align`), with covariances;
+   time, :mod:`~ground_station.estimation.align`), with covariances;
 2. fuse: selective fusion for the work UAV's xhat, feedback for each support's yhat_n; with
    ``roles.policy: dynamic`` the work UAV's own GNSS fix judged and, trusted, fused too
    (:mod:`~ground_station.roles.own_fix`);
@@ -28,19 +28,19 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ground_station.align import align
-from ground_station.arrival import check_arrival
-from ground_station.fusion import FusionResult, SupportMeasurement, fuse
-from ground_station.gnss_map import learn
+from ground_station.control.arrival import check_arrival
+from ground_station.control.plan import FormationPlan, plan, solve_supports
+from ground_station.control.run_context import RunContext
+from ground_station.control.work_mpc import WorkPrediction
+from ground_station.estimation.align import align
+from ground_station.estimation.fusion import FusionResult, SupportMeasurement, fuse
+from ground_station.estimation.gnss_map import learn
+from ground_station.estimation.localize import SupportReport, localize
 from ground_station.integrity.monitor import Verdict
-from ground_station.localize import SupportReport, localize
-from ground_station.plan import FormationPlan, plan, solve_supports
 from ground_station.roles.allocation import allocate
 from ground_station.roles.own_fix import OwnFix, combined_estimate, judge
-from ground_station.run_context import RunContext
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from ground_station.support_mpc.mpc import SupportPlan
-from ground_station.work_mpc import WorkPrediction
 
 
 @dataclass(frozen=True)
@@ -173,7 +173,11 @@ def complete_cycle(
 
 
 def run_cycle(
-    state: StationState, reports: Sequence[SupportReport], context: RunContext
+    state: StationState,
+    reports: Sequence[SupportReport],
+    context: RunContext,
+    work_fix: np.ndarray | None = None,
 ) -> CycleOutput:
-    """A whole cycle with nothing sent in between (the detached run, tests)."""
-    return complete_cycle(state, control_cycle(state, reports, context), context)
+    """A whole cycle with nothing sent in between (the detached run of
+    :mod:`mission.bench.detached`, tests)."""
+    return complete_cycle(state, control_cycle(state, reports, context, work_fix), context)

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ground_station.roles.assignment import Allocation
+from ground_station.state.assignment import Allocation
 
 
 @dataclass
@@ -29,10 +29,3 @@ class StationState:
         """Drop what was carried for a support that fell silent and is back."""
         self.warm.pop(support, None)
         self.last_support_command.pop(support, None)
-
-
-def reachable(start: np.ndarray, target: np.ndarray, reach: float) -> np.ndarray:
-    """The displacement a vehicle makes toward ``target`` in one cycle, at most ``reach``."""
-    move = target - start
-    distance = float(np.linalg.norm(move))
-    return move if distance <= reach else move * (reach / distance)

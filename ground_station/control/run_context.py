@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ground_station.gnss_map import LocalizabilityMap
+from ground_station.estimation.gnss_map import LocalizabilityMap
 from ground_station.integrity.monitor import IntegrityMonitor
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from ground_station.support_mpc.mpc import SupportMpc
 from ground_station.support_mpc.sharing import HelperPlanner, LocalPlanner, MpcHelper
 from mission.config.settings import Scenario

@@ -1,4 +1,5 @@
-"""MPC of the work UAV (paper 4.2.1, Algorithm 1 as MODEL.md reconstructs it)."""
+"""MPC of the work UAV (paper 4.2.1, Algorithm 1 as docs/model.md, "MPCs (4.2.1, 4.2.2)",
+reconstructs it)."""
 
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 
 
 def check_arrival(state: StationState, waypoints: np.ndarray, tolerance_m: float) -> int | None:

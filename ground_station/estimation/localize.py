@@ -14,7 +14,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ground_station.fusion import SupportMeasurement
+from ground_station.estimation.fusion import SupportMeasurement
 from mission.world.frames import GeodeticFrame, ned_to_enu
 from mission.world.model import KnownWorld
 
@@ -108,9 +108,10 @@ def plausible_fix(fix: np.ndarray | None, world: KnownWorld) -> bool:
 
 
 def localize(values: Sequence[SupportReport], world: KnownWorld) -> list[SupportMeasurement]:
-    """p_n and r_n with covariances evaluated at the measured values (MODEL.md 3.2.1): the GNSS
-    geometry of every fix in one batch and the camera's Sigma_r of every observation in
-    another (the same numbers as one at a time, tested).
+    """p_n and r_n with covariances evaluated at the measured values (docs/model.md, "Selective
+    fusion (3.2.1) and feedback (3.2.2)"): the GNSS geometry of every fix in one batch and the
+    camera's Sigma_r of every observation in another (the same numbers as one at a time,
+    tested).
 
     Where the model sees no fix at p_n but the receiver has one, the receiver's reported
     accuracy stands in for Sigma_GNSS. A fix more than :data:`IMPLAUSIBLE_FIX_M` outside the

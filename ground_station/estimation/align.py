@@ -20,8 +20,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ground_station.localize import SupportReport
-from ground_station.state import StationState
+from ground_station.estimation.localize import SupportReport
+from ground_station.state.station_state import StationState
 
 
 def align(

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import casadi as ca
 import numpy as np
 
-from ground_station.fusion import SupportMeasurement
+from ground_station.estimation.fusion import SupportMeasurement
 from mission.config.settings import MapSettings
 from mission.world.grid import VoxelGrid
 

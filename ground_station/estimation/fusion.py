@@ -4,8 +4,9 @@ Each support n with a fix p_n and a valid observation r_n gives the likelihood
 N(mu_n, Sigma_n), mu_n = p_n + r_n, Sigma_n = Sigma_GNSS(p_n) + Sigma_r(r_n). Supports whose
 likelihoods correlate (Pearson, over a broad particle set around the predicted position) with
 at least half of the contributing supports (``agreement: paper``: half of all N) form the
-consistent set S; xhat is the candidate
-particle maximising sum_{n in S} log f(x; mu_n, Sigma_n). Interpretations: MODEL.md 3.2.
+consistent set S; xhat is the candidate particle maximising sum_{n in S} log f(x; mu_n,
+Sigma_n). Interpretations: docs/model.md, "Selective fusion (3.2.1) and feedback (3.2.2)" and
+"Supports counted in the agreement test".
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ground_station.state import StationState
+from ground_station.state.station_state import StationState
 from mission.config.settings import FusionSettings
 
 
@@ -119,7 +120,7 @@ def fuse(
     predicted = state.xhat + state.last_work_command
     fusion = selective_fusion(supports, predicted, settings, rng)
     # Blind, the work UAV's estimate is dead-reckoned: where its last command took it (the
-    # position its autopilot believes, which it then holds: ground_station.plan).
+    # position its autopilot believes, which it then holds: ground_station.control.plan).
     state.xhat = predicted if fusion.xhat is None else fusion.xhat
     betas: dict[str, float | None] = {}
     for support in supports:
@@ -196,7 +197,8 @@ def support_feedback(
     previous_yhat: np.ndarray,
     last_command: np.ndarray,
 ) -> Feedback:
-    """Feed xhat back to a support's estimate (3.2.2) with MODEL.md's fallbacks."""
+    """Feed xhat back to a support's estimate (3.2.2), with the fallbacks of docs/model.md,
+    "Selective fusion (3.2.1) and feedback (3.2.2)"."""
     if support.fix_m is None:
         return Feedback(previous_yhat + last_command, None)
     if support.relative_m is None or fusion.xhat is None:

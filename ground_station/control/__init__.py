@@ -1,0 +1,1 @@
+"""The control cycle. Imports: config, world, state, estimation, integrity, support_mpc, roles."""

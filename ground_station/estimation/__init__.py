@@ -1,0 +1,1 @@
+"""What the station believes: fused estimates, the map G. Imports: config, world, state."""

@@ -1,0 +1,1 @@
+"""What a control cycle carries to the next: estimates, commands, roles. Imports: nothing."""
