@@ -33,6 +33,10 @@ SHORT_NAMES = {  # the names the docstrings use for the project's packages
     "ground_station": "ground_station",
     "support_mpc": "ground_station.support_mpc",
     "vehicle_sim": "vehicle_sim",
+    "dynamics": "vehicle_sim.dynamics",
+    "mavlink": "vehicle_sim.mavlink",
+    "sensors": "vehicle_sim.sensors",
+    "process": "vehicle_sim.process",
 }
 
 

@@ -1,6 +1,6 @@
 """One simulated multicopter: state, message handling, stepping and telemetry (no sockets).
 
-The process around it (:mod:`vehicle_sim.server`) owns the sockets and the clock and calls
+The process around it (:mod:`vehicle_sim.process.server`) owns the sockets and the clock and calls
 :meth:`Vehicle.handle` for each message and :meth:`Vehicle.step` / :meth:`Vehicle.publish`
 for each simulation step.
 """
@@ -25,17 +25,18 @@ from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.frames import GeodeticFrame
 from mission.world.model import World
 from mission.world.proximity import StructureProximity
-from vehicle_sim import failures, modes, streams, telemetry
-from vehicle_sim.auto_mission import fly_mission
-from vehicle_sim.contact import Contact, ContactDetector, ContactWatch, as_sent
-from vehicle_sim.failures import SensorFailures
-from vehicle_sim.fault_schedule import FaultSchedule
-from vehicle_sim.gnss_receiver import GnssReceiver
-from vehicle_sim.incoming import HANDLERS
-from vehicle_sim.kinematics import Kinematics
-from vehicle_sim.mission_server import MissionServer
-from vehicle_sim.param_server import ParamServer
-from vehicle_sim.parameters import vehicle_parameters
+from vehicle_sim.dynamics.contact import Contact, ContactDetector, ContactWatch, as_sent
+from vehicle_sim.dynamics.kinematics import Kinematics
+from vehicle_sim.mavlink import modes, streams, telemetry
+from vehicle_sim.mavlink.auto_mission import fly_mission
+from vehicle_sim.mavlink.incoming import HANDLERS
+from vehicle_sim.mavlink.mission_server import MissionServer
+from vehicle_sim.mavlink.param_server import ParamServer
+from vehicle_sim.mavlink.parameters import vehicle_parameters
+from vehicle_sim.sensors import failures
+from vehicle_sim.sensors.failures import SensorFailures
+from vehicle_sim.sensors.fault_schedule import FaultSchedule
+from vehicle_sim.sensors.gnss_receiver import GnssReceiver
 
 GCS_SYSTEM_ID = 255
 SENSOR_STREAMS = (
@@ -156,7 +157,8 @@ class Vehicle:
         return True
 
     def _apply_faults(self) -> None:
-        """The scenario's faults due at this step boundary (:mod:`vehicle_sim.fault_schedule`)."""
+        """The scenario's faults due at this step boundary
+        (:mod:`vehicle_sim.sensors.fault_schedule`)."""
         for change in self.faults.due(self.sim_time_s):
             fault = change.fault
             if fault.failure is not None:
@@ -369,7 +371,7 @@ def _motion(
     scenario = world.scenario
     if scenario.vehicle.dynamics == "multicopter":
         from mission.world.surfaces import VerticalSurfaces
-        from vehicle_sim.multicopter import Multicopter
+        from vehicle_sim.dynamics.multicopter import Multicopter
 
         return Multicopter.at(
             home,

@@ -17,7 +17,7 @@ from ground_station.localize import SupportReport
 from ground_station.roles.allocation import inspections_left
 from ground_station.run_context import build_run_context
 from mission.world.model import World
-from vehicle_sim.kinematics import Kinematics
+from vehicle_sim.dynamics.kinematics import Kinematics
 
 
 @dataclass(frozen=True)

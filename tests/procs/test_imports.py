@@ -20,7 +20,7 @@ def test_a_run_without_inspections_imports_no_scipy():
     code = (
         "import sys, numpy as np;"
         "from mission.commands import run; from mission.runs import orchestrator;"
-        "from ground_station import cli, station, cycle; from vehicle_sim import server;"
+        "from ground_station import cli, station, cycle; from vehicle_sim.process import server;"
         "from mission.world.model import World;"
         "from mission.link.plan_check import check_recall_in_time;"
         "from mission.link.plan_files import read_plan;"

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim.server import ClockSettings, VehicleServer
+from vehicle_sim.process.server import ClockSettings, VehicleServer
 
 
 class _Breaking:

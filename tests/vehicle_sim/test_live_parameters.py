@@ -12,7 +12,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint
 from mission.link.vehicle_identity import VehicleIdentity
-from vehicle_sim import modes
+from vehicle_sim.mavlink import modes
 from vehicle_sim.vehicle import Vehicle
 
 
@@ -177,7 +177,7 @@ def test_link_loss_set_live_drops_that_share_of_what_the_vehicle_sends(along_wor
 def test_the_scenario_s_failure_names_are_the_vehicle_s():
     """A fault the scenario accepts is one the vehicle can inject, and the other way round."""
     from mission.config.fault_settings import FAILURE_TYPES
-    from vehicle_sim import failures
+    from vehicle_sim.sensors import failures
 
     for unit, kinds in FAILURE_TYPES.items():
         for kind in kinds:

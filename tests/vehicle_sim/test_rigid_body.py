@@ -13,7 +13,7 @@ import pytest
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
 from mission.config.scenario import load_scenario
-from vehicle_sim.rigid_body import (
+from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     POSITION,
     RATES,

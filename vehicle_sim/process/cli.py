@@ -31,9 +31,9 @@ from mission.procs.cli_common import (
     run_guarded,
 )
 from mission.world.model import World
-from vehicle_sim.server import ClockSettings, VehicleServer
-from vehicle_sim.signals import install_signal_handlers
-from vehicle_sim.truth_link import TruthReceiver, TruthSender
+from vehicle_sim.process.server import ClockSettings, VehicleServer
+from vehicle_sim.process.signals import install_signal_handlers
+from vehicle_sim.process.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 
 

@@ -7,9 +7,9 @@ from typing import Any, Protocol
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim import modes
-from vehicle_sim.mission_server import MissionServer
-from vehicle_sim.param_server import ParamServer
+from vehicle_sim.mavlink import modes
+from vehicle_sim.mavlink.mission_server import MissionServer
+from vehicle_sim.mavlink.param_server import ParamServer
 
 
 class Vehicle(Protocol):
@@ -120,7 +120,7 @@ def _request_message(vehicle: Vehicle, params: list[float]) -> int:
 
 
 def _inject_failure(vehicle: Vehicle, params: list[float]) -> int:
-    """MAV_CMD_INJECT_FAILURE: param1 the unit, param2 the type (vehicle_sim.failures)."""
+    """MAV_CMD_INJECT_FAILURE: param1 the unit, param2 the type (vehicle_sim.sensors.failures)."""
     if math.isnan(params[0]) or math.isnan(params[1]):
         return DENIED
     if not vehicle.params.table.value("SIM_FAIL_ENABLE"):

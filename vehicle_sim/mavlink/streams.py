@@ -8,13 +8,13 @@ from typing import Any
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim import telemetry
+from vehicle_sim.mavlink import telemetry
 
 
 def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -> Any:
     """Build one message of a stream for the current state of ``vehicle`` (a
     :class:`~vehicle_sim.vehicle.Vehicle`, which calls this); None where a failed sensor
-    publishes nothing (:mod:`~vehicle_sim.failures`)."""
+    publishes nothing (:mod:`~vehicle_sim.sensors.failures`)."""
     k = vehicle.kinematics
     if message_id == mavlink2.MAVLINK_MSG_ID_SIM_STATE:
         return telemetry.sim_state(k.truth, k.velocity, vehicle.frame, _attitude(k))

@@ -29,7 +29,7 @@ from mission.config.multicopter_settings import (
     AutopilotSettings,
     MulticopterSettings,
 )
-from vehicle_sim.rigid_body import (
+from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     POSITION,
     RATES,

@@ -14,7 +14,7 @@ Stepping lives in :class:`~vehicle_sim.vehicle.Vehicle`; this module only decide
 
 Each step ends with SYSTEM_TIME (the step marker the ground station waits for). A support's
 camera sample of a step needs the work UAV's truth at the same physical time
-(:mod:`vehicle_sim.truth_link`); it is waited for briefly: in lockstep up to
+(:mod:`vehicle_sim.process.truth_link`); it is waited for briefly: in lockstep up to
 ``truth_timeout_wall_s``, in real time up to one step's wall time (then interpolated). In
 lockstep, after a wait that timed out, none is waited for again until a newer truth arrives
 (a frozen work UAV would otherwise cost every step the timeout).
@@ -37,8 +37,8 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.link.mavlink_udp import Address, UdpEndpoint
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.procs.wall_grid import next_grid_instant
-from vehicle_sim.signals import signal_wakeup
-from vehicle_sim.truth_link import TruthReceiver, TruthSender
+from vehicle_sim.process.signals import signal_wakeup
+from vehicle_sim.process.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 
 PEER_EXPIRY_WALL_S = 30.0
