@@ -1,8 +1,9 @@
-"""The rigid body flown by its autopilot over one simulation step (issue 31): at every substep
-the position controller (:mod:`vehicle_sim.dynamics.autopilot_loops`) computes the rotors' commands,
-held while the body (:mod:`vehicle_sim.dynamics.rigid_body`) is integrated over the substep (a
-classical Runge-Kutta step) and the controller's integral by Euler, as a flight controller's
-loop runs at a fixed rate. One casadi Function does a whole step, compiled with the system C
+"""The rigid body flown by its autopilot over one simulation step (docs/model.md, "A
+multicopter's dynamics"): at every substep the position controller
+(:mod:`~vehicle_sim.dynamics.autopilot_loops`) computes the rotors' commands, held while the
+body (:mod:`~vehicle_sim.dynamics.rigid_body`) is integrated over the substep (a classical
+Runge-Kutta step) and the controller's integral by Euler, as a flight controller's loop runs
+at a fixed rate. One casadi Function does a whole step, compiled with the system C
 compiler and cached as the support MPC is; the same inputs give the same state bit for bit.
 
 State (20): the body's 17, then the controller's velocity-error integral (3). A step also
