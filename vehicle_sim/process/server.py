@@ -142,7 +142,7 @@ class VehicleServer:
         assert self.vehicle is not None
         self._origin_wall, self._origin_unix = time.monotonic(), time.time()
         if not self.clock.lockstep:  # steps on the host's common beat (sensors on a PPS)
-            step_wall = self.vehicle.step_s / self.clock.speedup
+            step_wall = self.vehicle.clock.step_s / self.clock.speedup
             self._origin_wall, self._origin_unix = next_grid_instant(step_wall)
         sources: list[Any] = [self.endpoint]
         if self.truth_receiver is not None:
@@ -193,8 +193,8 @@ class VehicleServer:
             if self._started:
                 return self._last_tick_wall + vehicle.scenario.vehicle.lockstep_timeout_wall_s
             return self._last_idle_heartbeat + IDLE_HEARTBEAT_WALL_S
-        step_wall = vehicle.step_s / self.clock.speedup
-        return self._origin_wall + (vehicle.steps + 1) * step_wall
+        step_wall = vehicle.clock.step_s / self.clock.speedup
+        return self._origin_wall + (vehicle.clock.steps + 1) * step_wall
 
     def _on_message(self, message: Any, sender: Address, now: float) -> None:
         vehicle = self.vehicle
@@ -232,7 +232,7 @@ class VehicleServer:
                 self.endpoint.send_many(self._last_step, [sender])
                 self.stats.resent_steps += 1
             return
-        if not self._started and vehicle.steps == 0 and time_s > vehicle.step_s + 1e-9:
+        if not self._started and vehicle.clock.steps == 0 and time_s > vehicle.clock.step_s + 1e-9:
             if time_s > MAX_JOIN_S:  # SYSTEM_TIME's time_boot_ms (uint32 ms) would overflow
                 vehicle.counters.reject("clock tick too far ahead")
                 return
@@ -261,10 +261,10 @@ class VehicleServer:
         instant in real time."""
         vehicle = self.vehicle
         assert vehicle is not None
-        steps = vehicle.steps - steps_back
+        steps = vehicle.clock.steps - steps_back
         if self.clock.lockstep:
-            return round(steps * vehicle.step_s * 1e6)
-        step_wall = vehicle.step_s / self.clock.speedup
+            return round(steps * vehicle.clock.step_s * 1e6)
+        step_wall = vehicle.clock.step_s / self.clock.speedup
         return round((self._origin_unix + steps * step_wall) * 1e6)
 
     def _others_last_step(self) -> dict[str, tuple[Any, Any]] | None:
@@ -273,7 +273,7 @@ class VehicleServer:
         that starts this one (it left before the vehicle's step marker)."""
         receiver, vehicle = self.truth_receiver, self.vehicle
         assert vehicle is not None
-        if receiver is None or vehicle.steps == 0:
+        if receiver is None or vehicle.clock.steps == 0:
             return None
         receiver.drain()
         motions = receiver.motions(self._physical_usec(1), self._physical_usec())
@@ -286,7 +286,7 @@ class VehicleServer:
         timeout = vehicle.scenario.vehicle.truth_timeout_wall_s
         if self.clock.lockstep:
             return timeout
-        return min(timeout, vehicle.step_s / self.clock.speedup)
+        return min(timeout, vehicle.clock.step_s / self.clock.speedup)
 
     # -- stepping ---------------------------------------------------------------------------
     def _advance(self, now: float) -> None:
@@ -300,15 +300,17 @@ class VehicleServer:
             timeout = vehicle.scenario.vehicle.lockstep_timeout_wall_s
             idle = self._requested_s <= vehicle.sim_time_s + 1e-9
             if idle and now - self._last_tick_wall > timeout:
-                self._requested_s = vehicle.sim_time_s + vehicle.step_s
+                self._requested_s = vehicle.sim_time_s + vehicle.clock.step_s
                 self._last_tick_wall = now
                 self.stats.auto_steps += 1
             while self._requested_s > vehicle.sim_time_s + 1e-9:
                 if not self._do_step(now):
                     return
         else:
-            due = math.floor((now - self._origin_wall) * self.clock.speedup / vehicle.step_s + 1e-9)
-            while vehicle.steps < due:
+            due = math.floor(
+                (now - self._origin_wall) * self.clock.speedup / vehicle.clock.step_s + 1e-9
+            )
+            while vehicle.clock.steps < due:
                 if not self._do_step(now):
                     return
 
@@ -380,7 +382,8 @@ class VehicleServer:
         receiver = self.truth_receiver
         between, beyond = (receiver.interpolated, receiver.extrapolated) if receiver else (0, 0)
         return (
-            f"{vehicle.identity.name}: {vehicle.steps} steps to t={vehicle.sim_time_s:.1f} s; "
+            f"{vehicle.identity.name}: {vehicle.clock.steps} steps to "
+            f"t={vehicle.sim_time_s:.1f} s; "
             f"link {self.endpoint.summary()}; vehicle rejected: "
             f"{dict(sorted(vehicle.counters.rejected.items())) or 'none'}; "
             f"auto steps {self.stats.auto_steps}, truth waits timed out "
