@@ -1,1 +1,1 @@
-"""The vehicle process: CLI, sockets, pacing. Imports: config, world, link, procs, vehicle_sim."""
+"""The process: CLI, sockets, pacing. Imports: config, world, link, procs, dynamics, vehicle_sim."""

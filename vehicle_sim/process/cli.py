@@ -31,7 +31,8 @@ from mission.procs.cli_common import (
     run_guarded,
 )
 from mission.world.model import World
-from vehicle_sim.process.server import ClockSettings, VehicleServer
+from vehicle_sim.process.pacing import ClockSettings
+from vehicle_sim.process.server import VehicleServer
 from vehicle_sim.process.signals import install_signal_handlers
 from vehicle_sim.process.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
@@ -148,7 +149,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         world,
         home,
         args.seed,
-        server.broadcast,
+        server.outbox.broadcast,
         speedup=clock.speedup,
         link_loss=link.loss,
     )
