@@ -38,6 +38,10 @@ SHORT_NAMES = {  # the names the docstrings use for the project's packages
     "control": "ground_station.control",
     "links": "ground_station.links",
     "vehicle_sim": "vehicle_sim",
+    "dynamics": "vehicle_sim.dynamics",
+    "mavlink": "vehicle_sim.mavlink",
+    "sensors": "vehicle_sim.sensors",
+    "process": "vehicle_sim.process",
 }
 
 

@@ -1,5 +1,5 @@
 """Builders of the MAVLink messages the ground station sends (pymavlink's generated classes
-only): the mirror of :mod:`vehicle_sim.telemetry`."""
+only): the mirror of :mod:`vehicle_sim.mavlink.telemetry`."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 A vehicle is sent a position setpoint (SET_POSITION_TARGET_LOCAL_NED) each control cycle,
 after the estimate that resets what it believes (VISION_POSITION_ESTIMATE; a blind work UAV
 gets none and goes on with its own belief). Over the cycle an ideal vehicle - the kinematic
-point of :mod:`vehicle_sim.kinematics` - would move from its belief toward the setpoint by
+point of :mod:`vehicle_sim.dynamics.kinematics` - would move from its belief toward the setpoint by
 at most its speed limit times the cycle. The **tracking error** of a cycle is the distance
 between where the vehicle then believes it is (LOCAL_POSITION_NED at the next cycle's time,
 before that cycle's estimate) and where the ideal vehicle would be. It is measured in the

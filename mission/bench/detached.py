@@ -17,7 +17,7 @@ from ground_station.control.run_context import build_run_context
 from ground_station.estimation.localize import SupportReport
 from ground_station.roles.allocation import inspections_left
 from mission.world.model import World
-from vehicle_sim.kinematics import Kinematics
+from vehicle_sim.dynamics.kinematics import Kinematics
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ Ids follow ArduPilot where it has the same setting (``WPNAV_SPEED``, ``FS_GCS_TI
 ``SR0_*``, ``SIM_GPS1_*``, ``SIM_WIND_SPD``, ``SIM_WIND_DIR``), our own ``SIM_*`` where it has
 none (ArduPilot's ``SIM_WIND_TURB`` is an amplitude in m/s; ours, ``SIM_WIND_DRYDEN``, scales
 MIL-F-8785C's intensities). The vehicle builds its table
-from this catalogue and the scenario (``vehicle_sim.parameters``); a scenario's ``faults:``
+from this catalogue and the scenario (``vehicle_sim.mavlink.parameters``); a scenario's ``faults:``
 are checked against it before any process starts. docs/vehicle.md lists every entry.
 """
 

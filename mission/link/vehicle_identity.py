@@ -48,5 +48,6 @@ class VehicleIdentity:
         return base_port + self.instance
 
     def default_truth_port(self, base_port: int = BASE_PORT) -> int:
-        """UDP port a support vehicle listens on for the work UAV's truth (simulation only)."""
+        """UDP port the vehicle listens on for every other vehicle's truth (simulation only:
+        the supports' cameras need the work UAV's, contact needs everyone's)."""
         return base_port + TRUTH_PORT_OFFSET + self.instance

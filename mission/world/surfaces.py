@@ -1,6 +1,6 @@
 """The surfaces straight above and below points: the deck's underside a rotor flies under, the
 ground or a pier's top it flies over (the ceiling and ground effects of a flying vehicle,
-:mod:`vehicle_sim.rigid_body`).
+:mod:`vehicle_sim.dynamics.rigid_body`).
 
 Box primitives answer in closed form (a box is above a point when the point's x and y lie within
 its footprint and its underside is not below the point); a mesh file answers by casting a ray

@@ -18,7 +18,7 @@ from mission.analysis.metrics import read_tlog, trace_metrics
 from mission.analysis.truth import TimesyncReply, clock_offsets, interpolate
 from mission.world.frames import GeodeticFrame
 from tests.tlog_reference import read_tlog_with_mavutil
-from vehicle_sim import telemetry
+from vehicle_sim.mavlink import telemetry
 
 OFFSETS = {1: 3.2, 2: 11.7}  # each vehicle's clock minus the ground station's (s)
 PHASES = {1: 0.13, 2: 0.31}  # when in each 0.5 s the vehicle steps, on the station's clock

@@ -26,7 +26,7 @@ from mission.link.plan_files import read_plan
 from mission.world.frames import GeodeticFrame
 from mission.world.model import KnownWorld, World
 from mission.world.zones import MultipathZones
-from vehicle_sim import telemetry
+from vehicle_sim.mavlink import telemetry
 
 NAMES = ("work", "support-1", "support-2", "support-3")
 

@@ -13,8 +13,8 @@ import pytest
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
 from mission.config.scenario import load_scenario
-from vehicle_sim.closed_loop import ClosedLoop
-from vehicle_sim.rigid_body import ATTITUDE, POSITION, THRUSTS, VELOCITY, resting_state
+from vehicle_sim.dynamics.closed_loop import ClosedLoop
+from vehicle_sim.dynamics.rigid_body import ATTITUDE, POSITION, THRUSTS, VELOCITY, resting_state
 
 BODY, LOOPS = load_scenario("along").vehicle.multicopter, load_scenario("along").vehicle.autopilot
 TICK_S = 0.02  # steps this short, to watch the response

@@ -11,7 +11,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.config.scenario import load_scenario
 from mission.link.vehicle_identity import VehicleIdentity
 from mission.world.model import World
-from vehicle_sim.contact import as_sent
+from vehicle_sim.dynamics.contact import as_sent
 from vehicle_sim.vehicle import Vehicle
 
 RADIUS = 0.25  # the default vehicle.radius_m

@@ -9,8 +9,8 @@ import math
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim import failures
-from vehicle_sim.failures import SensorFailures
+from vehicle_sim.sensors import failures
+from vehicle_sim.sensors.failures import SensorFailures
 
 GPS_ID = mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT
 CAMERA_ID = mavlink2.MAVLINK_MSG_ID_LANDING_TARGET

@@ -10,7 +10,7 @@ import pytest
 from mission.config.scenario import load_scenario
 from mission.world.frames import GeodeticFrame
 from mission.world.model import World
-from vehicle_sim import telemetry
+from vehicle_sim.mavlink import telemetry
 
 EDGE = np.array([-11.0, -6.5, 7.8])  # beside the deck's south edge: a reflection tracked
 OPEN = np.array([0.0, -19.0, 15.0])  # open sky: carrier-fixed

@@ -9,15 +9,19 @@ from types import SimpleNamespace
 os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim.server import ClockSettings, VehicleServer
+from vehicle_sim.dynamics.clock import StepClock
+from vehicle_sim.process.pacing import ClockSettings
+from vehicle_sim.process.server import VehicleServer
 
 
 class _Breaking:
     """A vehicle whose handler fails on every message."""
 
     identity = SimpleNamespace(system_id=2)
+    scenario = SimpleNamespace(vehicle=SimpleNamespace(lockstep_timeout_wall_s=2.0))
 
     def __init__(self) -> None:
+        self.clock = StepClock(0.1, 0.0)
         self.counters = SimpleNamespace(rejected=[], reject=lambda kind: self.counted(kind))
 
     def counted(self, kind: str) -> None:

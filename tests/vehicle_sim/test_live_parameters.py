@@ -12,7 +12,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint
 from mission.link.vehicle_identity import VehicleIdentity
-from vehicle_sim import modes
+from vehicle_sim.mavlink import modes
 from vehicle_sim.vehicle import Vehicle
 
 
@@ -121,20 +121,24 @@ def test_lag_sends_an_older_fix_stamped_now_and_the_rate_is_the_receiver_s(along
     assert [(m.lat, m.lon) for m in sent[lagged:]] == [(m.lat, m.lon) for m in fixes[:-lagged]]
     slow = _vehicle(along_world, OPEN_HOME)
     _set(slow, "SIM_GPS1_HZ", 1)
-    assert slow.intervals_s[GPS] == 1.0
+    assert slow.schedule.intervals_s[GPS] == 1.0
+
+
+def _observe(vehicle: Vehicle, work: np.ndarray):
+    return vehicle.camera.observe(vehicle.kinematics.truth, work)
 
 
 def test_camera_range_and_noise_and_tracking_noise_and_speed(along_world):
     work = OPEN_HOME + [4.0, 0.0, 0.0]
     near = _vehicle(along_world, OPEN_HOME)
-    assert near.observe(work).valid
+    assert _observe(near, work).valid
     _set(near, "SIM_CAM_RANGE", 3.0)
-    assert not near.observe(work).valid
+    assert not _observe(near, work).valid
     base = _vehicle(along_world, OPEN_HOME)
     louder = _vehicle(along_world, OPEN_HOME)
     _set(louder, "SIM_CAM_NOISE", 3.0)
     errors = [
-        np.std([v.observe(work).relative_m - [4, 0, 0] for _ in range(300)], axis=0)
+        np.std([_observe(v, work).relative_m - [4, 0, 0] for _ in range(300)], axis=0)
         for v in (base, louder)
     ]
     np.testing.assert_allclose(errors[1] / errors[0], 3.0, rtol=0.2)
@@ -145,7 +149,7 @@ def test_camera_range_and_noise_and_tracking_noise_and_speed(along_world):
     mover.arm(True)
     mover.kinematics.target = OPEN_HOME + [10.0, 0.0, 0.0]
     mover.step()
-    assert mover.kinematics.truth[0] - OPEN_HOME[0] == pytest.approx(0.2 * mover.step_s)
+    assert mover.kinematics.truth[0] - OPEN_HOME[0] == pytest.approx(0.2 * mover.clock.step_s)
 
 
 def test_link_loss_set_live_drops_that_share_of_what_the_vehicle_sends(along_world):
@@ -177,7 +181,7 @@ def test_link_loss_set_live_drops_that_share_of_what_the_vehicle_sends(along_wor
 def test_the_scenario_s_failure_names_are_the_vehicle_s():
     """A fault the scenario accepts is one the vehicle can inject, and the other way round."""
     from mission.config.fault_settings import FAILURE_TYPES
-    from vehicle_sim import failures
+    from vehicle_sim.sensors import failures
 
     for unit, kinds in FAILURE_TYPES.items():
         for kind in kinds:

@@ -10,7 +10,7 @@ import pytest
 
 from mission.config.scenario import load_scenario
 from tests.processes import EXIT_NOT_COMPLETED, mission
-from vehicle_sim.multicopter import Multicopter
+from vehicle_sim.dynamics.multicopter import Multicopter
 
 VEHICLE = load_scenario("along").vehicle
 STEP_S = 0.5
@@ -92,8 +92,8 @@ def test_a_run_with_multicopters_flies_its_first_minute(tmp_path):
 
 def test_the_view_draws_the_axes_of_the_attitude_reported():
     from mission.viewer.assemble import NOSE_M, UP_M, body_axes
-    from vehicle_sim.rigid_body import rotation
-    from vehicle_sim.telemetry import Attitude
+    from vehicle_sim.dynamics.rigid_body import rotation
+    from vehicle_sim.mavlink.telemetry import Attitude
 
     rng = np.random.default_rng(8)
     for _ in range(10):
@@ -110,7 +110,7 @@ def test_the_view_draws_the_axes_of_the_attitude_reported():
 def test_the_attitude_is_reported_in_mavlinks_frames():
     from scipy.spatial.transform import Rotation
 
-    from vehicle_sim.telemetry import Attitude
+    from vehicle_sim.mavlink.telemetry import Attitude
 
     enu_to_ned = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
     flu_to_frd = np.diag([1.0, -1.0, -1.0])
@@ -157,7 +157,7 @@ def test_between_estimates_the_belief_drifts_as_the_filters_velocity_error_says(
     """Held still with no estimate for 10 s, the belief's error is bias x T plus a random walk
     of the per-step noise: across 150 vehicles its spread per axis is
     sqrt((sigma_b T)^2 + sigma_n^2 dt T)."""
-    from vehicle_sim.closed_loop import ClosedLoop
+    from vehicle_sim.dynamics.closed_loop import ClosedLoop
 
     loops = VEHICLE.autopilot
     loop = ClosedLoop(VEHICLE.multicopter, loops, STEP_S)

@@ -16,13 +16,13 @@ from mission.config.multicopter_settings import STANDARD_GRAVITY as G
 from mission.config.scenario import load_scenario
 from mission.world.proximity import StructureProximity
 from mission.world.surfaces import VerticalSurfaces
-from vehicle_sim.contact import STRUCTURE, ContactDetector
-from vehicle_sim.multicopter import Multicopter
-from vehicle_sim.rigid_body import (
+from tests.vehicle_sim.rigid_body_alone import RigidBody
+from vehicle_sim.dynamics.contact import STRUCTURE, ContactDetector
+from vehicle_sim.dynamics.multicopter import Multicopter
+from vehicle_sim.dynamics.rigid_body import (
     OPEN_AIR,
     POSITION,
     RATES,
-    RigidBody,
     proximity_gain,
     resting_state,
 )

@@ -13,13 +13,13 @@ import pytest
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
 from mission.config.scenario import load_scenario
-from vehicle_sim.rigid_body import (
+from tests.vehicle_sim.rigid_body_alone import RigidBody
+from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     POSITION,
     RATES,
     THRUSTS,
     VELOCITY,
-    RigidBody,
     resting_state,
     substeps_of,
 )

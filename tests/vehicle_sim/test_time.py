@@ -107,7 +107,7 @@ def test_a_support_waits_for_the_work_uavs_truth_of_the_step_up_to_the_timeout(t
     Truth samples are keyed by simulated microseconds in lockstep."""
     import numpy as np
 
-    from vehicle_sim.truth_link import TruthSender
+    from vehicle_sim.process.truth_link import TruthSender
 
     timeout = 2.0
     with vehicle_process("support-1", scenario=str(_short_waits(tmp_path, timeout))) as support:
@@ -139,7 +139,7 @@ def test_a_support_does_not_wait_for_a_truth_older_than_one_it_has(tmp_path):
     waiting for it would only stall the support for the timeout at every such step."""
     import numpy as np
 
-    from vehicle_sim.truth_link import TruthSender
+    from vehicle_sim.process.truth_link import TruthSender
 
     timeout = 2.0
     with vehicle_process("support-1", scenario=str(_short_waits(tmp_path, timeout))) as support:
@@ -186,7 +186,7 @@ def test_in_real_time_a_support_interpolates_the_truth_and_answers_timesync_at_o
     import numpy as np
     from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-    from vehicle_sim.truth_link import TruthSender
+    from vehicle_sim.process.truth_link import TruthSender
 
     with vehicle_process("support-1", "--speedup", "10") as support:
         assert support.truth_port is not None
@@ -230,7 +230,7 @@ def test_after_a_wait_that_timed_out_a_silent_work_uav_is_not_waited_for_again(t
     truth arrives again."""
     import numpy as np
 
-    from vehicle_sim.truth_link import TruthSender
+    from vehicle_sim.process.truth_link import TruthSender
 
     timeout = 1.0
     with vehicle_process("support-1", scenario=str(_short_waits(tmp_path, timeout))) as support:

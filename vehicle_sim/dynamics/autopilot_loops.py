@@ -1,5 +1,6 @@
-"""The autopilot's position controller for the rigid body (issue 31), as casadi expressions run
-at the integration rate: the cascade ArduPilot's and PX4's multicopter controllers use.
+"""The autopilot's position controller for the rigid body (docs/model.md, "A multicopter's
+dynamics"), as casadi expressions run at the integration rate: the cascade ArduPilot's and
+PX4's multicopter controllers use.
 
 1. position error (from where the autopilot *believes* it is) -> velocity setpoint, capped
    at the speed limit;
@@ -29,7 +30,7 @@ from mission.config.multicopter_settings import (
     AutopilotSettings,
     MulticopterSettings,
 )
-from vehicle_sim.rigid_body import (
+from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     POSITION,
     RATES,

@@ -8,33 +8,31 @@ from typing import Any
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim import telemetry
+from vehicle_sim.mavlink import telemetry
 
 
 def build(vehicle: Any, message_id: int, work_truth: np.ndarray | None = None) -> Any:
     """Build one message of a stream for the current state of ``vehicle`` (a
     :class:`~vehicle_sim.vehicle.Vehicle`, which calls this); None where a failed sensor
-    publishes nothing (:mod:`~vehicle_sim.failures`)."""
-    k = vehicle.kinematics
+    publishes nothing (:mod:`~vehicle_sim.sensors.failures`)."""
+    k, clock = vehicle.kinematics, vehicle.clock
     if message_id == mavlink2.MAVLINK_MSG_ID_SIM_STATE:
         return telemetry.sim_state(k.truth, k.velocity, vehicle.frame, _attitude(k))
     if message_id == mavlink2.MAVLINK_MSG_ID_ATTITUDE:
         attitude = _attitude(k)
         return (
-            None if attitude is None else telemetry.attitude_message(attitude, vehicle.time_boot_ms)
+            None if attitude is None else telemetry.attitude_message(attitude, clock.time_boot_ms)
         )
     if message_id == mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED:
-        return telemetry.local_position_ned(k.believed, k.velocity, vehicle.time_boot_ms)
+        return telemetry.local_position_ned(k.believed, k.velocity, clock.time_boot_ms)
     if message_id == mavlink2.MAVLINK_MSG_ID_GLOBAL_POSITION_INT:
         return telemetry.global_position_int(
-            k.believed, k.velocity, np.zeros(3), vehicle.frame, vehicle.time_boot_ms
+            k.believed, k.velocity, np.zeros(3), vehicle.frame, clock.time_boot_ms
         )
     if message_id == mavlink2.MAVLINK_MSG_ID_GPS_RAW_INT:
-        return vehicle.gnss.reading(k.truth, vehicle.time_unix_usec)
+        return vehicle.gnss.reading(k.truth, clock.time_unix_usec)
     if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
-        observed = vehicle.observe(work_truth)
-        healthy = telemetry.landing_target(observed, vehicle.time_unix_usec, 1)
-        return vehicle.failures.filter(message_id, healthy)
+        return vehicle.camera.reading(k.truth, work_truth, clock.time_unix_usec)
     if message_id == mavlink2.MAVLINK_MSG_ID_HEARTBEAT:
         return vehicle.heartbeat()
     if message_id == mavlink2.MAVLINK_MSG_ID_SYS_STATUS:

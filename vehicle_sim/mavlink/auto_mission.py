@@ -8,7 +8,7 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mission_items import GLOBAL_FRAMES, NAV_POSITION_COMMANDS
-from vehicle_sim import modes
+from vehicle_sim.mavlink import modes
 
 
 def fly_mission(vehicle: Any) -> None:

@@ -17,7 +17,7 @@ from mission.world.frames import (
     swap_attitude_frames,
 )
 from mission.world.gnss import GnssFix
-from vehicle_sim import modes
+from vehicle_sim.mavlink import modes
 
 UINT16_UNKNOWN = 65535
 SOFTWARE_VERSION = (0 << 24) | (1 << 16) | (0 << 8) | 255  # 0.1.0, FIRMWARE_VERSION_TYPE_OFFICIAL
@@ -26,7 +26,7 @@ CAPABILITIES = (
     | mavlink2.MAV_PROTOCOL_CAPABILITY_COMMAND_INT
     | mavlink2.MAV_PROTOCOL_CAPABILITY_SET_POSITION_TARGET_LOCAL_NED
     | mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2
-    | mavlink2.MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST  # parameters: vehicle_sim.parameters
+    | mavlink2.MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST  # see parameters.py
 )
 
 

@@ -18,7 +18,7 @@ from mission.link.impairment import LinkSettings, add_link_arguments, link_setti
 from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.link.plan_files import read_vehicle_waypoints
 from mission.link.signing import read_signing_key
-from mission.link.vehicle_identity import BASE_PORT, TRUTH_PORT_OFFSET, VehicleIdentity
+from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
 from mission.procs.cli_common import (
     OneLineArgumentParser,
     check_port,
@@ -31,9 +31,10 @@ from mission.procs.cli_common import (
     run_guarded,
 )
 from mission.world.model import World
-from vehicle_sim.server import ClockSettings, VehicleServer
-from vehicle_sim.signals import install_signal_handlers
-from vehicle_sim.truth_link import TruthReceiver, TruthSender
+from vehicle_sim.process.pacing import ClockSettings
+from vehicle_sim.process.server import VehicleServer
+from vehicle_sim.process.signals import install_signal_handlers
+from vehicle_sim.process.truth_link import TruthReceiver, TruthSender
 from vehicle_sim.vehicle import Vehicle
 
 
@@ -148,7 +149,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         world,
         home,
         args.seed,
-        server.broadcast,
+        server.outbox.broadcast,
         speedup=clock.speedup,
         link_loss=link.loss,
     )
@@ -196,10 +197,11 @@ def _open_channels(
     supports: int,
 ) -> Channels:
     """Bind (or adopt) the vehicle's sockets."""
-    if args.truth_out is None:  # every other vehicle's truth port, counted from ours
-        others = [m for m in range(supports + 1) if m != identity.instance] if port else []
-        base = port - identity.instance + TRUTH_PORT_OFFSET
-        destinations = [(args.host, base + m) for m in others]
+    base_port = port - identity.instance  # the ports of the run's vehicles count from it
+    if args.truth_out is None:  # every other vehicle's truth port
+        everyone = [VehicleIdentity.from_system_id(m + 1) for m in range(supports + 1)]
+        others = [other for other in everyone if other != identity] if port else []
+        destinations = [(args.host, other.default_truth_port(base_port)) for other in others]
     else:
         destinations = [_address(text, "--truth-out") for text in args.truth_out]
     truth_sender = TruthSender(identity.system_id, destinations)
@@ -215,7 +217,7 @@ def _open_channels(
     channels = Channels(endpoint, truth_sender)
     truth_port = args.truth_port
     if truth_port is None:
-        truth_port = port + TRUTH_PORT_OFFSET if port else 0
+        truth_port = identity.default_truth_port(base_port) if port else 0
     check_port(truth_port, "--truth-port", allow_any=True)
     sock = _inherited_socket(args.truth_socket_fd, "--truth-socket-fd")
     defaulted = args.truth_port is None

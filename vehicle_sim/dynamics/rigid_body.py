@@ -1,5 +1,7 @@
-"""A quadrotor as a rigid body with four lagged rotors (issue 31), as casadi expressions
-integrated over a whole simulation step in one Function call.
+"""A quadrotor as a rigid body with four lagged rotors (docs/model.md, "A multicopter's
+dynamics"), as casadi expressions: its state's derivative and one integration substep, which
+:mod:`~vehicle_sim.dynamics.closed_loop` folds with the autopilot's loops over a whole
+simulation step in one Function call.
 
 The model is PX4 SIH's (``simulator_sih/sih.cpp``): thrust along the body's z axis from four
 rotors whose thrust follows the command with a first-order lag (``motor_tau_s``), moments from
@@ -143,38 +145,6 @@ def runge_kutta_substep(
 def substeps_of(step_s: float, rate_hz: float) -> int:
     """The fewest equal substeps of ``step_s`` at ``rate_hz`` or faster."""
     return max(1, math.ceil(step_s * rate_hz - 1e-9))
-
-
-class RigidBody:
-    """The model's step for one settings and step length: :meth:`advance` integrates it."""
-
-    def __init__(self, settings: MulticopterSettings, step_s: float) -> None:
-        self.settings = settings
-        self.step_s = step_s
-        self.substeps = substeps_of(step_s, settings.rate_hz)
-        h = step_s / self.substeps
-        state, command, wind = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("u", 4), ca.SX.sym("w", 3)
-        surfaces = ca.SX.sym("h", SURFACES_SIZE)
-        after = runge_kutta_substep(settings, state, command, wind, surfaces, h)
-        substep = ca.Function("substep", [state, command, wind, surfaces], [after])
-        self._step = substep.fold(self.substeps)
-
-    def advance(
-        self,
-        state: np.ndarray,
-        command: np.ndarray,
-        wind: np.ndarray,
-        surfaces: np.ndarray = OPEN_AIR,
-    ) -> np.ndarray:
-        """The state one step later, ``command``, ``wind`` and ``surfaces`` (the heights
-        above, then below, each rotor: :data:`OPEN_AIR` by default) held over it."""
-        count = self.substeps
-        held = [(command, 4), (wind, 3), (surfaces, SURFACES_SIZE)]
-        result = self._step(
-            np.asarray(state, dtype=float),
-            *(np.repeat(np.asarray(v, dtype=float).reshape(n, 1), count, axis=1) for v, n in held),
-        )
-        return np.asarray(result, dtype=float).reshape(STATE_SIZE)
 
 
 def resting_state(

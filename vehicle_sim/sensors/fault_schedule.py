@@ -9,10 +9,12 @@ back the value it had when the fault started; a failure's end is the unit health
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from mission.config.fault_settings import Fault
+from vehicle_sim.mavlink.parameters import ParameterTable
+from vehicle_sim.sensors import failures
 
 TIME_TOLERANCE_S = 1e-9
 
@@ -52,3 +54,43 @@ class FaultSchedule:
             count += 1
         due, self._pending = self._pending[:count], self._pending[count:]
         return due
+
+
+class FaultInjector:
+    """Applies a vehicle's scheduled faults as they come due: a failure through the vehicle's
+    failure injection, a parameter set in its table and passed to the vehicle's hook for a
+    change, both said as ``Fault``."""
+
+    def __init__(
+        self,
+        schedule: FaultSchedule,
+        parameters: ParameterTable,
+        inject_failure: Callable[[int, int, str], bool],
+        parameter_set: Callable[[str, float, str], None],
+    ) -> None:
+        self.schedule = schedule
+        self._parameters = parameters
+        self._inject_failure = inject_failure
+        self._parameter_set = parameter_set
+        self._before_fault: dict[int, float] = {}  # a parameter's value before its fault
+
+    def apply_due(self, time_s: float) -> None:
+        """Every change due by ``time_s`` (at a step boundary)."""
+        if not len(self.schedule):
+            return
+        for change in self.schedule.due(time_s):
+            fault = change.fault
+            if fault.failure is not None:
+                unit, kind = failures.parse_failure(fault.failure)
+                self._inject_failure(unit, failures.OK if change.ends else kind, "Fault")
+                continue
+            table = self._parameters
+            index = table.index_of(str(fault.param))
+            assert index is not None  # the scenario's check: a catalogue id
+            if change.ends:
+                value = self._before_fault.pop(index)
+            else:
+                self._before_fault[index] = table[index].value
+                value = float(fault.value)  # type: ignore[arg-type]
+            table.set(index, value)
+            self._parameter_set(table[index].name, value, "Fault")

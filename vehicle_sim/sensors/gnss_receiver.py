@@ -7,7 +7,7 @@ fields say the same sigma); the glitch ``SIM_GPS1_GLTCH_X/Y/Z`` added (degrees o
 and longitude and metres of altitude, as ArduPilot's SITL adds its glitch); the fix of
 ``SIM_GPS1_LAG_MS`` earlier (whole samples), stamped now, as a receiver that does not know
 its latency sends it (the failure DELAYED, by contrast, keeps the old stamp); then an
-injected failure (:mod:`~vehicle_sim.failures`). At the defaults (scale 1, no glitch, no
+injected failure (:mod:`~vehicle_sim.sensors.failures`). At the defaults (scale 1, no glitch, no
 lag) the fix is the world's, draw for draw.
 """
 
@@ -22,9 +22,9 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.world.frames import GeodeticFrame
 from mission.world.model import World
-from vehicle_sim import telemetry
-from vehicle_sim.failures import SensorFailures, restamped
-from vehicle_sim.parameters import ParameterTable
+from vehicle_sim.mavlink import telemetry
+from vehicle_sim.mavlink.parameters import ParameterTable
+from vehicle_sim.sensors.failures import SensorFailures, restamped
 
 MAX_LAG_S = 1.0
 

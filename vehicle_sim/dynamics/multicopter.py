@@ -1,7 +1,8 @@
-"""A vehicle's motion as a flying quadrotor (``vehicle.dynamics: multicopter``, issue 31): the
-rigid body of :mod:`vehicle_sim.rigid_body` flown by the position controller of
-:mod:`vehicle_sim.autopilot_loops` over each step, with the interface of
-:class:`~vehicle_sim.kinematics.Kinematics` (truth, belief, target, velocity).
+"""A vehicle's motion as a flying quadrotor (``vehicle.dynamics: multicopter``; docs/model.md,
+"A multicopter's dynamics"): the rigid body of :mod:`~vehicle_sim.dynamics.rigid_body` flown by
+the position controller of :mod:`~vehicle_sim.dynamics.autopilot_loops` over each step, with
+the interface of :class:`~vehicle_sim.dynamics.kinematics.Kinematics` (truth, belief, target,
+velocity).
 
 The autopilot steers from the position it believes. Its belief is the truth plus an offset that
 each VISION_POSITION_ESTIMATE sets (the estimate's error, as the kinematic model keeps it);
@@ -23,8 +24,8 @@ from mission.config.wind_settings import WindSettings
 from mission.world.frames import quaternion_matrix
 from mission.world.surfaces import VerticalSurfaces
 from mission.world.wind import VehicleWind
-from vehicle_sim.closed_loop import ClosedLoop
-from vehicle_sim.rigid_body import (
+from vehicle_sim.dynamics.closed_loop import ClosedLoop
+from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     OPEN_AIR,
     POSITION,

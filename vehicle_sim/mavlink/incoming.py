@@ -16,9 +16,9 @@ import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.world.frames import ned_to_enu
-from vehicle_sim import modes
-from vehicle_sim.commands import execute, set_mode
-from vehicle_sim.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
+from vehicle_sim.mavlink import modes
+from vehicle_sim.mavlink.commands import execute, set_mode
+from vehicle_sim.mavlink.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
 
 WARNING_REPEAT_S = 5.0
 ESTIMATE_RESTART_S = 2.0  # an estimate stamped further back than this is a sender restarted

@@ -1,11 +1,11 @@
-"""The MAVLink parameter protocol of one vehicle, over its :mod:`~vehicle_sim.parameters`.
+"""The MAVLink parameter protocol of one vehicle, over its :mod:`~vehicle_sim.mavlink.parameters`.
 
 PARAM_REQUEST_LIST sends every parameter once, with its index and the count; PARAM_REQUEST_READ
 answers by index, or by id when the index is -1; PARAM_SET is always answered with the
 parameter's PARAM_VALUE, the new value (which the vehicle applies and announces) or, refused,
 the unchanged one, with a STATUSTEXT saying why. A read or set of an id the vehicle does not
 have gets a STATUSTEXT and no value (there is none to give), as a request of an index out of
-range gets nothing. MAVLink FTP gets a NAK at once (:mod:`~vehicle_sim.ftp_server`).
+range gets nothing. MAVLink FTP gets a NAK at once (:mod:`~vehicle_sim.mavlink.ftp_server`).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from typing import Any
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim.ftp_server import answer_ftp
-from vehicle_sim.parameters import ParameterTable
+from vehicle_sim.mavlink.ftp_server import answer_ftp
+from vehicle_sim.mavlink.parameters import ParameterTable
 
 
 class ParamServer:

@@ -1,8 +1,9 @@
-"""The rigid body flown by its autopilot over one simulation step (issue 31): at every substep
-the position controller (:mod:`vehicle_sim.autopilot_loops`) computes the rotors' commands,
-held while the body (:mod:`vehicle_sim.rigid_body`) is integrated over the substep (a
-classical Runge-Kutta step) and the controller's integral by Euler, as a flight controller's
-loop runs at a fixed rate. One casadi Function does a whole step, compiled with the system C
+"""The rigid body flown by its autopilot over one simulation step (docs/model.md, "A
+multicopter's dynamics"): at every substep the position controller
+(:mod:`~vehicle_sim.dynamics.autopilot_loops`) computes the rotors' commands, held while the
+body (:mod:`~vehicle_sim.dynamics.rigid_body`) is integrated over the substep (a classical
+Runge-Kutta step) and the controller's integral by Euler, as a flight controller's loop runs
+at a fixed rate. One casadi Function does a whole step, compiled with the system C
 compiler and cached as the support MPC is; the same inputs give the same state bit for bit.
 
 State (20): the body's 17, then the controller's velocity-error integral (3). A step also
@@ -16,8 +17,8 @@ import numpy as np
 
 from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
 from mission.procs.casadi_cache import Compiling, compiled_function
-from vehicle_sim.autopilot_loops import motor_commands
-from vehicle_sim.rigid_body import (
+from vehicle_sim.dynamics.autopilot_loops import motor_commands
+from vehicle_sim.dynamics.rigid_body import (
     OPEN_AIR,
     STATE_SIZE,
     SURFACES_SIZE,
@@ -88,7 +89,7 @@ class ClosedLoop:
         """(the state a step later, (n, 3) the position after every few substeps, the last one
         the step's end: :func:`path_stride`); ``wind`` (3,) held over the step, or
         (substeps, 3) one vector a substep; ``surfaces`` the heights above, then below, each
-        rotor (:data:`~vehicle_sim.rigid_body.OPEN_AIR`: none near)."""
+        rotor (:data:`~vehicle_sim.dynamics.rigid_body.OPEN_AIR`: none near)."""
         wind = np.asarray(wind, dtype=float)
         winds = np.repeat(wind.reshape(3, 1), self.substeps, axis=1) if wind.ndim == 1 else wind.T
         final, path = self._step(state, target, belief_offset, speed_limit_m_s, surfaces, winds)

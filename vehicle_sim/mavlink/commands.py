@@ -7,21 +7,21 @@ from typing import Any, Protocol
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from vehicle_sim import modes
-from vehicle_sim.mission_server import MissionServer
-from vehicle_sim.param_server import ParamServer
+from vehicle_sim.mavlink import modes
+from vehicle_sim.mavlink.mission_server import MissionServer
+from vehicle_sim.mavlink.param_server import ParamServer
+from vehicle_sim.mavlink.stream_schedule import StreamSchedule
 
 
 class Vehicle(Protocol):
     """What the commands act on (:class:`vehicle_sim.vehicle.Vehicle`)."""
 
-    intervals_s: dict[int, float | None]
+    schedule: StreamSchedule
     mission: MissionServer
 
     def send(self, message: Any) -> None: ...
     def arm(self, armed: bool) -> None: ...
     def change_mode(self, mode: int) -> None: ...
-    def set_interval(self, message_id: int, interval_us: float) -> bool: ...
     def build_stream(self, message_id: int, work_truth: Any = None) -> Any: ...
     def notify(self, severity: int, text: str) -> None: ...
     def inject_failure(self, unit: int, kind: int) -> bool: ...
@@ -85,17 +85,17 @@ def _set_interval(vehicle: Vehicle, params: list[float]) -> int:
     message_id = _interval_id(params[0])
     if message_id is None or math.isnan(params[1]) or params[1] > MAX_INTERVAL_US:
         return DENIED  # an interval MESSAGE_INTERVAL could not report back
-    return ACCEPTED if vehicle.set_interval(message_id, params[1]) else UNSUPPORTED
+    return ACCEPTED if vehicle.schedule.set_interval(message_id, params[1]) else UNSUPPORTED
 
 
 def _get_interval(vehicle: Vehicle, params: list[float]) -> int:
     message_id = _interval_id(params[0])
     if message_id is None:
         return DENIED
-    if message_id not in vehicle.intervals_s:
+    if message_id not in vehicle.schedule.intervals_s:
         vehicle.send(mavlink2.MAVLink_message_interval_message(message_id, 0))
         return ACCEPTED
-    interval = vehicle.intervals_s[message_id]
+    interval = vehicle.schedule.intervals_s[message_id]
     vehicle.send(
         mavlink2.MAVLink_message_interval_message(
             message_id, -1 if interval is None else round(interval * 1e6)
@@ -108,7 +108,7 @@ def _request_message(vehicle: Vehicle, params: list[float]) -> int:
     if math.isnan(params[0]):
         return DENIED
     message_id = int(params[0])
-    if message_id not in vehicle.intervals_s and message_id not in REQUESTABLE_ONCE:
+    if message_id not in vehicle.schedule.intervals_s and message_id not in REQUESTABLE_ONCE:
         return UNSUPPORTED
     if message_id == mavlink2.MAVLINK_MSG_ID_LANDING_TARGET:
         return DENIED  # a camera sample needs the step's truth; it comes with the stream
@@ -120,7 +120,7 @@ def _request_message(vehicle: Vehicle, params: list[float]) -> int:
 
 
 def _inject_failure(vehicle: Vehicle, params: list[float]) -> int:
-    """MAV_CMD_INJECT_FAILURE: param1 the unit, param2 the type (vehicle_sim.failures)."""
+    """MAV_CMD_INJECT_FAILURE: param1 the unit, param2 the type (vehicle_sim.sensors.failures)."""
     if math.isnan(params[0]) or math.isnan(params[1]):
         return DENIED
     if not vehicle.params.table.value("SIM_FAIL_ENABLE"):

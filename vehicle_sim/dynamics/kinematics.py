@@ -1,5 +1,6 @@
-"""Vehicle motion (MODEL.md "Vehicles and time"): the autopilot steers toward its target from
-the position it *believes*, so an estimate error moves the true vehicle wrongly."""
+"""Vehicle motion as a kinematic point (docs/vehicle.md, "Navigation"): the autopilot steers
+toward its target from the position it *believes*, so an estimate error moves the true vehicle
+wrongly."""
 
 from __future__ import annotations
 

@@ -1,0 +1,1 @@
+"""The vehicle's MAVLink side: messages, protocols, commands. Imports: config, world, link."""

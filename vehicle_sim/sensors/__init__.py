@@ -1,0 +1,1 @@
+"""The vehicle's sensors, their failures, the scenario's faults. Imports: config, world, mavlink."""
