@@ -7,7 +7,7 @@ import pytest
 
 import ground_station.cli as gcs_cli
 import mission.cli as mission_cli
-import vehicle_sim.process.cli as vehicle_cli
+import vehicle_sim.cli as vehicle_cli
 from tests.bad_input.command_cases import COMMAND_CASES
 from tests.bad_input.file_cases import FILE_CASES
 

@@ -8,7 +8,7 @@ import pytest
 
 import ground_station.cli as gcs_cli
 import mission.cli as mission_cli
-import vehicle_sim.process.cli as vehicle_cli
+import vehicle_sim.cli as vehicle_cli
 
 
 def _parsers() -> list[tuple[str, argparse.ArgumentParser]]:

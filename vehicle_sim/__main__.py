@@ -8,7 +8,7 @@ from mission.procs.numerics import prepare_numerics
 def main() -> int:
     """Set up the numerics, then run the command line."""
     prepare_numerics()  # before anything imports numpy
-    from vehicle_sim.process.cli import entry_point  # numpy loads here, after the set-up
+    from vehicle_sim.cli import entry_point  # numpy loads here, after the set-up
 
     return entry_point()
 

@@ -1,6 +1,6 @@
 """One simulated multicopter: state, message handling, stepping and telemetry (no sockets).
 
-The process around it (:mod:`vehicle_sim.process.server`) owns the sockets and the pacing and
+The process around it (:mod:`vehicle_sim.server`) owns the sockets and the pacing and
 calls :meth:`Vehicle.handle` for each message and :meth:`Vehicle.step` /
 :meth:`Vehicle.publish` for each simulation step.
 """

@@ -16,7 +16,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-# vehicle_sim.process.server.VehicleServer.summary's words (tested against a real run)
+# vehicle_sim.server.VehicleServer.summary's words (tested against a real run)
 _COUNTS = re.compile(r"auto steps (\d+), truth waits timed out (\d+)")
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 ROLE_FRAMES = (  # the first of these a process's stack holds says what it is
     ("serve_descriptors (ground_station/support_mpc/helper.py", "mpc helper"),
     ("entry_point (ground_station/cli.py", "ground station"),
-    ("entry_point (vehicle_sim/process/cli.py", "vehicle"),
+    ("entry_point (vehicle_sim/cli.py", "vehicle"),
 )
 PHASE_FRAMES = (  # the orchestrator's phases, by the frame its stack holds
     ("_summary (mission/runs/orchestrator.py", "orchestrator: analysis"),

@@ -255,7 +255,7 @@ def _vehicle_main(scenario: Scenario) -> Callable[[list[str]], int]:
     """The vehicles' entry point, imported here once for the four forks; with flying vehicles
     also their dynamics (casadi and the flight code), which each would otherwise import for
     itself, four at once on two cores."""
-    from vehicle_sim.process.cli import entry_point
+    from vehicle_sim.cli import entry_point
 
     if scenario.vehicle.dynamics == "multicopter":
         import vehicle_sim.dynamics.multicopter  # noqa: F401

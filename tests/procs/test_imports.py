@@ -21,7 +21,7 @@ def test_a_run_without_inspections_imports_no_scipy():
         "import sys, numpy as np;"
         "from mission.commands import run; from mission.runs import orchestrator;"
         "from ground_station import cli, station; from ground_station.control import cycle;"
-        "from vehicle_sim.process import server;"
+        "from vehicle_sim import server;"
         "from mission.world.model import World;"
         "from mission.link.plan_check import check_recall_in_time;"
         "from mission.link.plan_files import read_plan;"

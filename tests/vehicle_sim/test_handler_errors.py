@@ -11,7 +11,7 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from vehicle_sim.dynamics.clock import StepClock
 from vehicle_sim.process.pacing import ClockSettings
-from vehicle_sim.process.server import VehicleServer
+from vehicle_sim.server import VehicleServer
 
 
 class _Breaking:

@@ -1,1 +1,1 @@
-"""The process: CLI, sockets, pacing. Imports: config, world, link, procs, dynamics, vehicle_sim."""
+"""Server plumbing: outbox, pacing, truth link, signals. Imports: link, procs, world, dynamics."""

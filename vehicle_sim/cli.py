@@ -32,9 +32,9 @@ from mission.procs.cli_common import (
 )
 from mission.world.model import World
 from vehicle_sim.process.pacing import ClockSettings
-from vehicle_sim.process.server import VehicleServer
 from vehicle_sim.process.signals import install_signal_handlers
 from vehicle_sim.process.truth_link import TruthReceiver, TruthSender
+from vehicle_sim.server import VehicleServer
 from vehicle_sim.vehicle import Vehicle
 
 
