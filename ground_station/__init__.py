@@ -1,1 +1,1 @@
-"""The ground station (sees no zones nor truth). Imports: config, world, link, procs."""
+"""The ground station (sees no zones nor truth). Imports: config, world, link, procs, codegen."""

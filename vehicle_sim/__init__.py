@@ -1,1 +1,1 @@
-"""One simulated vehicle process. Imports: config, world, link, procs."""
+"""One simulated vehicle process. Imports: config, world, link, procs, codegen."""

@@ -1,1 +1,1 @@
-"""The support MPC: its NLP, solvers and margins. Imports: config, world, procs, estimation."""
+"""The support MPC: NLP, solvers, margins. Imports: config, world, procs, codegen, estimation."""

@@ -1,5 +1,5 @@
 """The support MPC's NLPs compiled to shared libraries with the system C compiler, and cached
-(:mod:`mission.procs.casadi_cache`): a plan takes about a quarter of the time it takes with
+(:mod:`mission.codegen.casadi_cache`): a plan takes about a quarter of the time it takes with
 casadi's interpreter. The first run generates and compiles (both NLPs at once, one compiler
 process each); later runs load the cached libraries and build nothing.
 """
@@ -11,8 +11,8 @@ from contextlib import contextmanager
 
 import casadi as ca
 
-from mission.procs import casadi_cache
-from mission.procs.casadi_cache import FunctionBuild, NlpBuild, c_compiler
+from mission.codegen import casadi_cache
+from mission.codegen.casadi_cache import FunctionBuild, NlpBuild, c_compiler
 
 __all__ = ["COMPILED", "COMPILING", "FunctionBuild", "NlpBuild", "c_compiler"]
 

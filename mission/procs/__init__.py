@@ -1,1 +1,1 @@
-"""Process helpers: forks, names, CLI errors, atomic writes, beat, casadi cache. Imports: config."""
+"""Process helpers: forks, names, CLI errors, atomic writes, beat. Imports: config."""

@@ -104,7 +104,7 @@ def test_an_interpreted_mpc_plans_as_the_compiled_one(along_world, local, monkey
     IPOPT's algorithm, and the interpreter evaluates the same functions."""
     from dataclasses import replace as replaced
 
-    from mission.procs import casadi_cache
+    from mission.codegen import casadi_cache
 
     def no_compiling(*_):
         raise AssertionError("compiled=False compiles nothing")

@@ -27,7 +27,7 @@ def _compiled_nlps(builds, fallback_dir):
     """Each build's library (None without a C compiler), compiled and cached as the support
     MPC's are, into ``fallback_dir()`` where the cache is not writable."""
     from ground_station.support_mpc import nlp_cache
-    from mission.procs import casadi_cache
+    from mission.codegen import casadi_cache
 
     return casadi_cache.compiled_builds(builds, fallback_dir, nlp_cache.SUPPORT_MPC)
 
@@ -88,7 +88,7 @@ def test_the_compiled_nlp_is_cached_and_a_hit_builds_nothing(tmp_path, monkeypat
     def no_solver(*args, **kwargs):
         raise AssertionError("a cache hit builds no solver from the expressions")
 
-    from mission.procs import casadi_cache
+    from mission.codegen import casadi_cache
 
     with monkeypatch.context() as hit:
         hit.setattr(casadi_cache.tempfile, "TemporaryDirectory", no_scratch)
@@ -127,7 +127,7 @@ def test_several_nlps_compile_at_once_and_only_the_missing_ones(tmp_path, monkey
     import casadi as ca
 
     from ground_station.support_mpc import nlp_cache
-    from mission.procs import casadi_cache
+    from mission.codegen import casadi_cache
 
     if c_compiler() is None:
         return

@@ -1,1 +1,1 @@
-"""How a vehicle moves (a point or a flown quadrotor), contact. Imports: config, world, procs."""
+"""How a vehicle moves (a point or a flown quadrotor), contact. Imports: config, world, codegen."""

@@ -1,0 +1,1 @@
+"""Numerical code compiled to C once per machine and cached (casadi). Imports: nothing."""
