@@ -19,17 +19,16 @@ from mission.link.plan_files import vehicle_names
 from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
 from mission.procs.atomic import write_text_atomically
-from mission.procs.cli_common import (
+from mission.procs.command_line import (
     OneLineArgumentParser,
     check_port,
     check_seed,
     check_speedup,
-    die_with_parent,
-    name_this_process,
     program_name,
     run_guarded,
 )
 from mission.procs.outputs import check_output_dir, check_output_file
+from mission.procs.process_life import die_with_parent, name_this_process
 from mission.procs.provenance import run_provenance
 from mission.world.model import KnownWorld
 

@@ -37,7 +37,7 @@ from ground_station.state.station_state import StationState
 from ground_station.support_mpc.sharing import MpcHelper
 from mission.link.impairment import LinkSettings
 from mission.link.mavlink_udp import Address
-from mission.procs.cli_common import freeze_startup_heap
+from mission.procs.process_life import freeze_startup_heap
 from mission.world.frames import GeodeticFrame
 from mission.world.model import KnownWorld
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from mission.commands import analyze, batch, bench, plan, run, study, view, world
-from mission.procs.cli_common import OneLineArgumentParser, program_name, run_guarded
+from mission.procs.command_line import OneLineArgumentParser, program_name, run_guarded
 
 COMMANDS = (world, plan, analyze, view, bench, run, batch, study)  # in --help's order
 

@@ -19,17 +19,16 @@ from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.link.plan_files import read_vehicle_waypoints
 from mission.link.signing import read_signing_key
 from mission.link.vehicle_identity import BASE_PORT, VehicleIdentity
-from mission.procs.cli_common import (
+from mission.procs.command_line import (
     OneLineArgumentParser,
     check_port,
     check_seed,
     check_speedup,
-    freeze_startup_heap,
-    name_this_process,
     parse_point,
     program_name,
     run_guarded,
 )
+from mission.procs.process_life import freeze_startup_heap, name_this_process
 from mission.world.model import World
 from vehicle_sim.process.pacing import ClockSettings
 from vehicle_sim.process.signals import install_signal_handlers

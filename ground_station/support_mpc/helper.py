@@ -49,7 +49,7 @@ def read_frame(stream: BinaryIO) -> Any:
 def serve(requests: BinaryIO, answers: BinaryIO) -> None:
     """Build the solver from the first frame, then answer request lists until end of input."""
     from ground_station.support_mpc.mpc import SupportMpc
-    from mission.procs.cli_common import freeze_startup_heap
+    from mission.procs.process_life import freeze_startup_heap
     from mission.world.model import KnownWorld
 
     try:
@@ -90,7 +90,7 @@ def serve_descriptors(argv: list[str]) -> int:
 
 
 def _serve_quietly(requests: BinaryIO, answers: BinaryIO) -> int:
-    from mission.procs.cli_common import name_this_process
+    from mission.procs.process_life import name_this_process
 
     name_this_process(PROCESS_NAME)
     signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -22,8 +22,8 @@ import numpy as np
 from ground_station.support_mpc.helper import read_frame, write_frame
 from ground_station.support_mpc.mpc import PlanRequest, SupportMpc, SupportPlan
 from mission.config.settings import Scenario
-from mission.procs.cli_common import child_environment
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
+from mission.procs.process_life import child_environment
 
 SET_UP_PIPE_BYTES = 1 << 20  # the set-up frame (a sigma_0 map of 40,000 voxels) is ~0.3 MB
 

@@ -96,7 +96,7 @@ def _check_options(speedup: float | None, key: str | Path | None, observer: str 
     """The real-time speed-up, the signing key's file and the observer's address."""
     from mission.link.mavlink_udp import parse_address
     from mission.link.signing import read_signing_key
-    from mission.procs.cli_common import check_speedup
+    from mission.procs.command_line import check_speedup
 
     if key is not None:
         read_signing_key(Path(key), "signing_key")  # names the file

@@ -6,8 +6,8 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
-from mission.procs.cli_common import child_environment
 from mission.procs.commands import mission_run_argv
+from mission.procs.process_life import child_environment
 
 
 def run_as_command(

@@ -10,8 +10,8 @@ import tempfile
 from pathlib import Path
 
 from mission.bench.result import BenchResult
-from mission.procs.cli_common import child_environment
 from mission.procs.commands import mission_run_argv
+from mission.procs.process_life import child_environment
 
 MAX_SLOWDOWN = 0.10  # the bound: at most 10 % slower with the live view
 

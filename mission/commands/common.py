@@ -9,7 +9,7 @@ from pathlib import Path
 
 from mission.config.errors import InputError
 from mission.config.scenario import embedded_scenario_names
-from mission.procs.cli_common import check_speedup
+from mission.procs.command_line import check_speedup
 from mission.procs.outputs import check_output_dir, check_output_file
 
 DEFAULT_SCENARIO = "along"

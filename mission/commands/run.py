@@ -15,7 +15,7 @@ from mission.commands.common import (
 )
 from mission.config.errors import InputError
 from mission.link.impairment import add_link_arguments, link_settings
-from mission.procs.cli_common import check_seed
+from mission.procs.command_line import check_seed
 from mission.procs.outputs import check_output_dir, run_files_in
 from mission.runs.stall import DEFAULT_STALL_S
 
@@ -97,11 +97,11 @@ def run(args: argparse.Namespace) -> int:
     """``mission run``: the flags checked (each named as given), then the run prepared and
     flown by the Python API (:mod:`mission.api.runner`), as ``mission.run`` flies it."""
     from mission.api.runner import announce, clear, fly, prepare
-    from mission.procs.cli_common import EXIT_NOT_COMPLETED
+    from mission.procs.command_line import EXIT_NOT_COMPLETED
     from mission.runs.orchestrator import RunFailed
 
     if args.exit_with_parent:
-        from mission.procs.cli_common import die_with_parent
+        from mission.procs.process_life import die_with_parent
 
         die_with_parent()
     check_seed(args.seed)

@@ -12,7 +12,7 @@ import numpy as np
 
 from mission.commands.common import add_scenario_argument, check_figure_path
 from mission.config.errors import InputError
-from mission.procs.cli_common import parse_point
+from mission.procs.command_line import parse_point
 
 DEFAULT_PLOT_POINT = (0.0, -7.0, 7.0)
 

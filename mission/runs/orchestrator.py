@@ -31,11 +31,11 @@ from mission.config.settings import Scenario
 from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
 from mission.procs.atomic import write_text_atomically
-from mission.procs.cli_common import child_environment
 from mission.procs.disk_full import EXIT_NO_SPACE
 from mission.procs.file_tail import FileTail
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
+from mission.procs.process_life import child_environment
 from mission.procs.provenance import run_provenance
 from mission.procs.stopping import stop_processes
 from mission.runs.stall import DEFAULT_STALL_S, StallWatch

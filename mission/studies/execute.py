@@ -18,8 +18,9 @@ import yaml
 
 from mission.config.scenario import resolved_mapping
 from mission.procs.atomic import write_text_atomically
-from mission.procs.cli_common import EXIT_NOT_COMPLETED, child_environment
+from mission.procs.command_line import EXIT_NOT_COMPLETED
 from mission.procs.commands import mission_run_argv
+from mission.procs.process_life import child_environment
 from mission.studies.runkeys import StudyRun
 
 Keep = Literal["all", "logs", "summary"]

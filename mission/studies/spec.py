@@ -38,7 +38,7 @@ from mission.config.scenario import (
     scenario_layers,
 )
 from mission.config.settings import Scenario
-from mission.procs.cli_common import MAX_SPEEDUP, MIN_SPEEDUP
+from mission.procs.command_line import MAX_SPEEDUP, MIN_SPEEDUP
 
 METHODS = ("ac", "nac")
 TABLES = ("table3",)

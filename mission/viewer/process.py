@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Literal
 from urllib.parse import quote
 
-from mission.procs.cli_common import die_with_parent
+from mission.procs.process_life import die_with_parent
 from mission.procs.stopping import stop_processes
 
 LOOPBACK = "127.0.0.1"

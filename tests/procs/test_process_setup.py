@@ -23,7 +23,7 @@ from mission.procs.numerics import (
 def test_freezing_the_start_up_heap_exempts_what_was_loaded_from_collection():
     code = (
         "import gc, numpy, pymavlink.dialects.v20.ardupilotmega\n"
-        "from mission.procs.cli_common import freeze_startup_heap\n"
+        "from mission.procs.process_life import freeze_startup_heap\n"
         "before = gc.get_freeze_count()\n"
         "freeze_startup_heap()\n"
         "print(before, gc.get_freeze_count())\n"

@@ -194,9 +194,11 @@ def test_a_child_whose_named_parent_is_gone_stops_itself(parent_is_named):
     the child compares its parent with the one named in MISSION_PARENT_PID and stops."""
     import os
 
-    from mission.procs.cli_common import PARENT_PID_VARIABLE
+    from mission.procs.process_life import PARENT_PID_VARIABLE
 
-    code = "from mission.procs.cli_common import die_with_parent; die_with_parent(); print('alive')"
+    code = (
+        "from mission.procs.process_life import die_with_parent; die_with_parent(); print('alive')"
+    )
     named = os.getpid() if parent_is_named else 1  # pid 1 is never this child's parent here
     env = {**os.environ, PARENT_PID_VARIABLE: str(named)}
     child = subprocess.run(

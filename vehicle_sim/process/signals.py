@@ -34,6 +34,6 @@ def install_signal_handlers(stop: Callable[..., None], die_with_parent: bool) ->
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGINT, stop)
     if die_with_parent:
-        from mission.procs.cli_common import die_with_parent as arrange
+        from mission.procs.process_life import die_with_parent as arrange
 
         arrange()
