@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.config.run_outputs import DEFAULT_SCENARIO, G_SNAPSHOTS
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.link.mavlink_udp import parse_address
 from mission.link.plan_check import check_plan_files
@@ -32,8 +33,6 @@ from mission.procs.process_life import die_with_parent, name_this_process
 from mission.procs.provenance import run_provenance
 from mission.world.model import KnownWorld
 
-G_SNAPSHOT_CHOICES = ("every", "ends", "none")  # ground_station.records.G_SNAPSHOTS (tested)
-
 
 def build_parser() -> OneLineArgumentParser:
     """Arguments of the ground-station process."""
@@ -41,7 +40,7 @@ def build_parser() -> OneLineArgumentParser:
         prog=program_name("ground_station", "mission-ground-station"),
         description="The ground station of one mission: fusion, the map G, the MPCs.",
     )
-    parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO, help="embedded name or YAML path")
     parser.add_argument(
         "--method",
         choices=["ac", "nac"],
@@ -93,7 +92,7 @@ def build_parser() -> OneLineArgumentParser:
     )
     parser.add_argument(
         "--g-snapshots",
-        choices=G_SNAPSHOT_CHOICES,
+        choices=G_SNAPSHOTS,
         default="every",
         help="which snapshots of G to write into OUT/g: every (the start, every 20 cycles and "
         "the end; the default, what the 3-D view replays), ends (the start and the end), none",

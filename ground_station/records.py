@@ -6,18 +6,17 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from ground_station.control.cycle import CycleOutput
 from ground_station.estimation.gnss_map import LocalizabilityMap
 from ground_station.state.station_state import StationState
+from mission.config.run_outputs import G_SNAPSHOTS, GSnapshots
 from mission.procs.atomic import write_text_atomically
 
 SNAPSHOT_EVERY = 20  # cycles between snapshots of G
-GSnapshots = Literal["every", "ends", "none"]
-G_SNAPSHOTS: tuple[GSnapshots, ...] = ("every", "ends", "none")
 ENDS = ("initial", "final")
 
 

@@ -31,10 +31,11 @@ from ground_station.links.outgoing import (
 from ground_station.links.tlog import TlogWriter
 from ground_station.links.vehicle_links import VehicleLinks
 from ground_station.preflight import arm_all, connect, upload_missions
-from ground_station.records import SNAPSHOT_EVERY, GSnapshots, RunRecords
+from ground_station.records import SNAPSHOT_EVERY, RunRecords
 from ground_station.roles.allocation import inspections_left
 from ground_station.state.station_state import StationState
 from ground_station.support_mpc.sharing import MpcHelper
+from mission.config.run_outputs import GSnapshots
 from mission.link.impairment import LinkSettings
 from mission.link.mavlink_udp import Address
 from mission.procs.process_life import freeze_startup_heap

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from mission.config.errors import InputError
+from mission.config.run_outputs import DEFAULT_SCENARIO
 from mission.link.impairment import LinkSettings, add_link_arguments, link_settings
 from mission.link.mavlink_udp import MavlinkCodec, UdpEndpoint, parse_address
 from mission.link.plan_files import read_vehicle_waypoints
@@ -43,7 +44,7 @@ def build_parser() -> OneLineArgumentParser:
         prog=program_name("vehicle_sim", "mission-vehicle"),
         description="One simulated UAV speaking MAVLink 2 over UDP.",
     )
-    parser.add_argument("--scenario", default="along", help="embedded name or YAML path")
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO, help="embedded name or YAML path")
     parser.add_argument("--vehicle", required=True, help="work or support-N")
     parser.add_argument("--host", default="127.0.0.1", help="address to listen on")
     parser.add_argument(

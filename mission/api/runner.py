@@ -15,6 +15,7 @@ from typing import Any, Literal
 
 from mission.api.run_data import Run
 from mission.config.errors import InputError
+from mission.config.run_outputs import DEFAULT_SCENARIO, GSnapshots
 from mission.config.settings import Scenario
 from mission.link.impairment import LinkSettings
 from mission.runs.orchestrator import RunOptions
@@ -39,7 +40,7 @@ class RunPlan:
 
 
 def prepare(
-    scenario: str | Path = "along",
+    scenario: str | Path = DEFAULT_SCENARIO,
     method: str = "ac",
     seed: int = 0,
     overrides: dict[str, Any] | None = None,
@@ -52,7 +53,7 @@ def prepare(
     link: LinkSettings | None = None,
     mpc_helper: bool | None = None,
     process_start: Literal["fork", "exec"] = "fork",
-    g_snapshots: Literal["every", "ends", "none"] = "every",
+    g_snapshots: GSnapshots = "every",
     stall_s: float = DEFAULT_STALL_S,
 ) -> RunPlan:
     """Every check of a run, nothing written: the scenario and its ``overrides`` (dotted
@@ -175,7 +176,7 @@ def fly(plan: RunPlan, live: Any = None) -> dict:
 
 
 def run(
-    scenario: str | Path = "along",
+    scenario: str | Path = DEFAULT_SCENARIO,
     method: str = "ac",
     seed: int = 0,
     overrides: dict[str, Any] | None = None,

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from mission.config.errors import InputError
+from mission.studies.execute import KEEP_CHOICES
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -84,7 +85,7 @@ def study(
 
     if engine not in ("local", "ray"):
         raise InputError(SOURCE, "engine", f"must be 'local' or 'ray', not {engine!r}")
-    if keep not in ("all", "logs", "summary"):
+    if keep not in KEEP_CHOICES:
         raise InputError(SOURCE, "keep", f"must be 'all', 'logs' or 'summary', not {keep!r}")
     if isinstance(spec_or_path, dict):
         spec = study_from_mapping(spec_or_path, Path(SOURCE))  # relative paths: from here

@@ -8,11 +8,10 @@ import sys
 from pathlib import Path
 
 from mission.config.errors import InputError
+from mission.config.run_outputs import DEFAULT_SCENARIO
 from mission.config.scenario import embedded_scenario_names
 from mission.procs.command_line import check_speedup
 from mission.procs.outputs import check_output_dir, check_output_file
-
-DEFAULT_SCENARIO = "along"
 
 
 def add_scenario_argument(parser: argparse.ArgumentParser) -> None:

@@ -14,6 +14,7 @@ from mission.commands.common import (
     realtime_speedup,
 )
 from mission.config.errors import InputError
+from mission.config.run_outputs import G_SNAPSHOTS
 from mission.link.impairment import add_link_arguments, link_settings
 from mission.procs.command_line import check_seed
 from mission.procs.outputs import check_output_dir, run_files_in
@@ -53,7 +54,7 @@ def add_parser(commands) -> None:
     )
     parser.add_argument(
         "--g-snapshots",
-        choices=["every", "ends", "none"],
+        choices=G_SNAPSHOTS,
         default="every",
         help="which snapshots of G the run keeps in OUT/g: every (the start, every 20 cycles "
         "and the end: what the 3-D view replays; the default), ends (the start and the end: "

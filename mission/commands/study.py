@@ -10,6 +10,7 @@ from pathlib import Path
 from mission.api.study_checks import check_study_outputs
 from mission.commands.study_verify import add_verify_arguments, verify_command
 from mission.config.errors import InputError
+from mission.studies.execute import KEEP_CHOICES
 
 
 def add_parser(commands) -> None:
@@ -48,7 +49,7 @@ def add_parser(commands) -> None:
     )
     parser.add_argument(
         "--keep",
-        choices=["all", "logs", "summary"],
+        choices=KEEP_CHOICES,
         default="all",
         help="of each run's folder: all; logs (all but G's snapshots); summary (and scenario)",
     )

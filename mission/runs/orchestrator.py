@@ -27,6 +27,7 @@ from typing import Any, Literal, Protocol
 from mission.analysis.lockstep import lockstep_integrity
 from mission.analysis.run_metrics import run_metrics
 from mission.config.errors import InputError
+from mission.config.run_outputs import G_SNAPSHOTS, GSnapshots
 from mission.config.settings import Scenario
 from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
@@ -66,7 +67,7 @@ class RunOptions:
     link: LinkSettings = field(default_factory=LinkSettings)  # impairment of every link
     mpc_helper: bool | None = None  # the ground station's MPC helper (None: its default)
     process_start: Literal["fork", "exec"] = "fork"  # fork: where safe, else exec
-    g_snapshots: Literal["every", "ends", "none"] = "every"  # the ground station's G snapshots
+    g_snapshots: GSnapshots = "every"  # the ground station's G snapshots
     stall_s: float = DEFAULT_STALL_S  # wall seconds without progress that stop it (0: never)
 
     def __post_init__(self) -> None:
@@ -74,8 +75,8 @@ class RunOptions:
             raise ValueError(f"stall_s must be finite and >= 0, not {self.stall_s!r}")
         if self.process_start not in ("fork", "exec"):
             raise ValueError(f"process_start must be fork or exec, not {self.process_start!r}")
-        if self.g_snapshots not in ("every", "ends", "none"):
-            raise ValueError(f"g_snapshots must be every, ends or none, not {self.g_snapshots!r}")
+        if self.g_snapshots not in G_SNAPSHOTS:
+            raise ValueError(f"g_snapshots must be one of {G_SNAPSHOTS}, not {self.g_snapshots!r}")
 
 
 class RunWatcher(Protocol):

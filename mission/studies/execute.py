@@ -12,7 +12,7 @@ import socket
 import subprocess
 import tarfile
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 import yaml
 
@@ -24,7 +24,7 @@ from mission.procs.process_life import child_environment
 from mission.studies.runkeys import StudyRun
 
 Keep = Literal["all", "logs", "summary"]
-KEEP_CHOICES = ("all", "logs", "summary")
+KEEP_CHOICES: tuple[Keep, ...] = get_args(Keep)
 FLOWN = (0, EXIT_NOT_COMPLETED)  # ``mission run``'s statuses for a run flown to its end
 SCENARIO_FILE = "scenario.yaml"
 

@@ -8,7 +8,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from ground_station.records import G_SNAPSHOTS, SNAPSHOT_EVERY, RunRecords
+from ground_station.records import SNAPSHOT_EVERY, RunRecords
+from mission.config.run_outputs import G_SNAPSHOTS
 
 
 @pytest.mark.parametrize(
@@ -39,10 +40,10 @@ def test_an_unknown_mode_is_refused():
 
 
 def test_the_command_lines_offer_the_records_choices():
-    from ground_station.cli import G_SNAPSHOT_CHOICES, build_parser
+    from ground_station.cli import build_parser
     from mission.cli import build_parser as mission_parser
 
-    assert G_SNAPSHOT_CHOICES == G_SNAPSHOTS
+    assert G_SNAPSHOTS == ("every", "ends", "none")
     assert build_parser().parse_args(["--g-snapshots", "ends"]).g_snapshots == "ends"
     run = mission_parser().parse_args(["run", "along", "--g-snapshots", "none"])
     assert run.g_snapshots == "none"
