@@ -34,7 +34,9 @@ def add_parser(commands) -> None:
         "--plot",
         type=Path,
         metavar="FILE.png|pdf|svg",
-        help="draw structure, zones, sky plot and sigma_0 slices",
+        help="draw sigma_0 on top views under the deck, at the work UAV's heights and above "
+        "the structure, on side and cross-section views through --at's point (default "
+        f"{' '.join(f'{v:g}' for v in DEFAULT_PLOT_POINT)}), and the sky there",
     )
     parser.add_argument(
         "--multipath-map",

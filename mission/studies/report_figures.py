@@ -47,71 +47,87 @@ def write_figures(
     return written
 
 
+MAX_COLUMNS = 3  # panels side by side, at least (a study of more scenarios: one per scenario)
+
+
+def panel_grid(metrics: int, scenarios: int) -> tuple[int, int]:
+    """(rows, columns) of a metrics figure: each metric a panel per scenario, the scenarios of
+    one metric side by side, as many metrics in a row as make at least MAX_COLUMNS columns."""
+    per_row = max(1, -(-MAX_COLUMNS // scenarios))
+    columns = scenarios * min(per_row, metrics)
+    return -(-metrics * scenarios // columns), columns
+
+
 def _metrics_against(path, spec, rows, scenarios, key, metrics) -> None:
     import matplotlib.pyplot as plt
 
     values = list(dict.fromkeys(_value(p, key) for p in spec.points))
     numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
     positions = {v: (v if numeric else i) for i, v in enumerate(values)}
-    varying = _varying_keys(spec)
     names = ["default" if v is None else str(v) for v in values]
     # many long names (a scenario's faults) do not fit under a tick: letters there, the names
     # listed under the panels
     lettered = not numeric and len(names) > 4 and max(map(len, names)) > 24
     key_lines = [f"{chr(65 + i)}: {n}" for i, n in enumerate(names)] if lettered else []
     key_height = 0.16 * len(key_lines) + (0.2 if key_lines else 0.0)
-    figure, axes = plt.subplots(
-        len(metrics),
-        len(scenarios),
-        figsize=(4.2 * len(scenarios), 2.6 * len(metrics) + key_height),
+    grid_rows, columns = panel_grid(len(metrics), len(scenarios))
+    figure, grid = plt.subplots(
+        grid_rows,
+        columns,
+        figsize=(4.2 * columns, 2.6 * grid_rows + key_height),
         squeeze=False,
     )
-    for column_index, scenario in enumerate(scenarios):
-        for row_index, (column, label) in enumerate(metrics):
-            axis = axes[row_index][column_index]
-            for (rest, method), points in _lines(spec, key, varying).items():
-                xs, ys, errors = [], [], []
-                for number, value in sorted(points, key=lambda point: positions[point[1]]):
-                    mine = [
-                        r
-                        for r in rows
-                        if r["scenario"] == scenario
-                        and r["point"] == number
-                        and r["method"] == method
-                    ]
-                    mean, half = mean_ci(metric_values(mine, column))
-                    if mean is not None:
-                        xs.append(positions[value])
-                        ys.append(mean)
-                        errors.append(half or 0.0)
-                if xs:
-                    name = method.upper() + (f", {rest}" if rest else "")
-                    axis.errorbar(xs, ys, yerr=errors, marker="o", capsize=3, label=name)
-            if lettered:
-                axis.set_xticks(range(len(values)), [chr(65 + i) for i in range(len(values))])
-            elif not numeric:  # a point that does not set the key flies the scenario's default
-                axis.set_xticks(range(len(values)), [textwrap.fill(n, 12) for n in names])
-                axis.tick_params(axis="x", labelsize=6)
-            axis.set_xlabel(key)
-            axis.set_ylabel(label, fontsize=8)
-            axis.grid(alpha=0.3)
-            if row_index == 0:
-                axis.set_title(scenario)
-    title = f"{spec.name}: each metric against {key} (mean, 95 % CI)"
-    _frame(figure, axes, title, key_lines, key_height)
+    cells = [axis for row in grid for axis in row]
+    panels = [(metric, scenario) for metric in metrics for scenario in scenarios]
+    lines = _lines(spec, key, _varying_keys(spec))
+    for axis, ((column, label), scenario) in zip(cells, panels):
+        mine = [r for r in rows if r["scenario"] == scenario]
+        _draw_lines(axis, lines, mine, column, positions)
+        if lettered:
+            axis.set_xticks(range(len(values)), [chr(65 + i) for i in range(len(values))])
+        elif not numeric:  # a point that does not set the key flies the scenario's default
+            axis.set_xticks(range(len(values)), [textwrap.fill(n, 12) for n in names])
+            axis.tick_params(axis="x", labelsize=6)
+        axis.set_xlabel(key, fontsize=8)
+        axis.set_ylabel(textwrap.fill(label, 34), fontsize=8)
+        axis.grid(alpha=0.3)
+        if len(scenarios) > 1:
+            axis.set_title(scenario, fontsize=9)
+    for axis in cells[len(panels) :]:
+        figure.delaxes(axis)  # the last row's empty cells
+    where = f" in {scenarios[0]}" if len(scenarios) == 1 else ""
+    title = f"{spec.name}: each metric against {key}{where} (mean, 95 % CI)"
+    _frame(figure, figure.axes, title, key_lines, key_height, columns)
     save_figure(figure, path)
 
 
-def _frame(figure, axes, title: str, key_lines: list[str], key_height: float) -> None:
-    """The title on top (wrapped to the figure's width), the legend of every panel's lines in
-    two columns under it, the panels below both, and the names of lettered points (if any)
-    under the panels."""
+def _draw_lines(axis, lines, rows, column: str, positions: dict) -> None:
+    """One metric's mean and CI per line, over ``rows`` (one scenario's)."""
+    for (rest, method), points in lines.items():
+        xs, ys, errors = [], [], []
+        for number, value in sorted(points, key=lambda point: positions[point[1]]):
+            mine = [r for r in rows if r["point"] == number and r["method"] == method]
+            mean, half = mean_ci(metric_values(mine, column))
+            if mean is not None:
+                xs.append(positions[value])
+                ys.append(mean)
+                errors.append(half or 0.0)
+        if xs:
+            name = method.upper() + (f", {rest}" if rest else "")
+            axis.errorbar(xs, ys, yerr=errors, marker="o", capsize=3, label=name)
+
+
+def _frame(figure, axes, title: str, key_lines: list[str], key_height: float, columns: int) -> None:
+    """The title on top (wrapped to the figure's width), the legend of every panel's lines
+    under it (in as many columns as the panels, at least two), the panels below both, and the
+    names of lettered points (if any) under the panels."""
     named = {}  # every line of every panel, once (a method may be missing from the first)
-    for axis in (a for row in axes for a in row):
+    for axis in axes:
         for handle, label in zip(*axis.get_legend_handles_labels()):
             named.setdefault(label, handle)
     height = figure.get_figheight()
-    legend_rows = -(-len(named) // 2)
+    legend_columns = max(1, min(len(named), max(2, columns)))
+    legend_rows = -(-len(named) // legend_columns)
     lines = textwrap.wrap(title, width=int(11 * figure.get_figwidth()))  # a narrow figure's
     extra = 0.22 * (len(lines) - 1)
     figure.suptitle("\n".join(lines), y=1 - 0.12 / height)
@@ -120,7 +136,7 @@ def _frame(figure, axes, title: str, key_lines: list[str], key_height: float) ->
         list(named),
         loc="upper center",
         bbox_to_anchor=(0.5, 1 - (0.42 + extra) / height),
-        ncol=2,
+        ncol=legend_columns,
         fontsize=7,
         frameon=False,
     )

@@ -1,5 +1,7 @@
 """Figures say which run they show and do not mislead: the scenario, method and seed in every
-title, NAC's G marked as not learned, box plots with every run and n, and PDF or SVG on ask."""
+title, NAC's G marked as not learned, faults and contacts marked, every line named (by what it
+is, never by a colour's name), titles clear of colour bars, 3-D views at one scale, box plots
+with every run and n, and PDF or SVG on ask."""
 
 from __future__ import annotations
 
@@ -61,6 +63,99 @@ def test_every_title_names_the_run_and_nac_says_g_was_not_learned(
     else:
         assert "final G" in texts and "1 voxel changed" in texts
         assert len(colour_bars) == 6
+
+
+def _faulted_trace() -> RunTrace:
+    """The trace with support 1's receiver off from 0.5 s to 1.0 s and its crash at 1.2 s."""
+    trace = _trace()
+    trace.events += [
+        {"t": 0.5, "vehicle": "support-1", "source": "scenario", "event": "gps off"},
+        {"t": 1.0, "vehicle": "support-1", "source": "scenario", "event": "gps ok"},
+    ]
+    trace.contacts.append(
+        {"t": 1.2, "vehicle": "support-1", "with": "structure", "at_m": [-5.0, 5.2, 8.5],
+         "crash": True}
+    )  # fmt: skip
+    return trace
+
+
+@pytest.fixture(scope="module")
+def faulted(along_world, tmp_path_factory) -> dict:
+    """plot_run's figures of the faulted trace (AC, one voxel of G learned), drawn once."""
+    made = {}
+    tmp_path = tmp_path_factory.mktemp("faulted")
+    g = tmp_path / "g"
+    g.mkdir()
+    initial = along_world.sigma0_map().sigma_m
+    np.save(g / "G_initial.npy", initial)
+    final = initial.copy()
+    final[5, 30, 8] += 0.7
+    np.save(g / "G_final.npy", final)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(run_plot, "save_figure", lambda fig, path: made.update({path.name: fig}))
+        plot_run(_faulted_trace(), along_world, g, tmp_path / "plots", RunLabel("along", "ac", 3))
+    return made
+
+
+def _legend_labels(fig) -> list[str]:
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend()] + fig.legends
+    return [text.get_text() for legend in legends for text in legend.get_texts()]
+
+
+def test_faults_and_a_crash_are_marked_where_and_when_they_happened(faulted):
+    made = faulted
+    error = made["error.png"].axes[0]
+    lines = {float(line.get_xdata()[0]) for line in error.get_lines() if line.get_xdata()[0]
+             == line.get_xdata()[-1] and len(line.get_xdata()) == 2}  # fmt: skip
+    assert {0.5, 1.0, 1.2} <= lines
+    texts = " ".join(text.get_text() for text in error.texts)
+    assert "support 1: gps off (t = 0.5 s)" in texts
+    assert "support 1: touched structure (t = 1.2 s)" in texts
+    for name in ("error.png", "trajectories.png"):
+        labels = _legend_labels(made[name])
+        assert any(label.startswith("scripted fault") for label in labels), name
+        assert "crash (the run stopped)" in labels, name
+    trajectories = made["trajectories.png"]
+    crossed = [
+        line
+        for ax in trajectories.axes
+        for line in ax.get_lines()
+        if line.get_marker() == "X" and line.get_linestyle() == "None"
+    ]
+    assert len(crossed) == 3  # the crash in the 3-D, top and side views
+    assert [float(crossed[1].get_xdata()[0]), float(crossed[1].get_ydata()[0])] == [-5.0, 5.2]
+
+
+def test_every_legend_names_what_a_line_is_and_no_colour(faulted):
+    made = faulted
+    for name, fig in made.items():
+        words = _legend_labels(fig) + [text.get_text() for ax in fig.axes for text in ax.texts]
+        assert not any("tab:" in word for word in words), name
+    labels = _legend_labels(made["trajectories.png"])
+    for vehicle in ("work UAV", "support 1", "multipath zone", "structure"):
+        assert vehicle in labels
+
+
+def test_the_3d_view_has_one_scale_on_every_axis(faulted):
+    made = faulted
+    (view,) = [ax for ax in made["trajectories.png"].axes if ax.name == "3d"]
+    spans = [np.ptp(limits) for limits in (view.get_xlim(), view.get_ylim(), view.get_zlim())]
+    aspect = view.get_box_aspect()
+    assert aspect / aspect[0] == pytest.approx(np.array(spans) / spans[0])
+
+
+def test_titles_stay_clear_of_colour_bars_and_inside_the_figure(faulted):
+    made = faulted
+    for name, fig in made.items():
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        bars = [ax.get_window_extent(renderer) for ax in fig.axes if ax.get_label() == "<colorbar>"]
+        for ax in fig.axes:
+            if not ax.get_title():
+                continue
+            title = ax.title.get_window_extent(renderer)
+            assert fig.bbox.x0 <= title.x0 and title.x1 <= fig.bbox.x1, (name, ax.get_title())
+            assert not any(title.overlaps(bar) for bar in bars), (name, ax.get_title())
 
 
 def test_box_plots_show_every_run_n_and_start_at_zero(monkeypatch, tmp_path):

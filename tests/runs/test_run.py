@@ -138,7 +138,7 @@ def test_run_completes_writes_a_summary_and_leaves_no_process(scenario, tmp_path
     metrics = json.loads(analyzed.stdout)  # the metrics alone (notes go to stderr)
     for name, size in [
         ("trajectories", (1500, 1100)),
-        ("error", (1100, 400)),
+        ("error", (1300, 420)),  # its legend beside the axes
         ("g_update", (1600, 900)),
     ]:
         header = (tmp_path / "a" / "plots" / f"{name}.png").read_bytes()[:24]

@@ -72,12 +72,9 @@ def test_many_long_point_names_are_letters_under_the_ticks_and_listed_below(tmp_
         assert f"{letter}: support-1 SIM_GPS1_GLTCH_Z={size:g}" in listed
 
 
-def test_the_legend_names_a_method_missing_from_the_first_panel_and_the_title_fits(
-    tmp_path, drawn, monkeypatch
-):
+def test_the_legend_names_a_method_missing_from_the_first_panel(tmp_path, drawn, monkeypatch):
     """No NAC run completes, so the first panel (completion time) has AC's line alone: the
-    legend still names NAC's lines from the other panels, and the long title is wrapped to a
-    one-scenario figure's width."""
+    legend still names NAC's lines from the other panels."""
     from tests.studies import test_study
 
     plain = test_study._summary
@@ -96,7 +93,35 @@ def test_the_legend_names_a_method_missing_from_the_first_panel_and_the_title_fi
     assert figure.axes[0].get_legend_handles_labels()[1] == ["AC"]
     labels = [text.get_text() for legend in figure.legends for text in legend.get_texts()]
     assert labels == ["AC", "NAC"]
-    title = figure._suptitle.get_text()
-    assert "\n" in title and all(
-        len(line) <= 11 * figure.get_figwidth() for line in title.split("\n")
-    )
+
+
+@pytest.mark.parametrize(
+    ("metrics", "scenarios", "grid"),
+    [(16, 1, (6, 3)), (3, 1, (1, 3)), (1, 1, (1, 1)), (11, 2, (6, 4)), (8, 3, (8, 3))],
+)
+def test_the_panels_make_a_grid_of_at_least_three_columns(metrics, scenarios, grid):
+    assert report_figures.panel_grid(metrics, scenarios) == grid
+
+
+def test_one_scenarios_many_metrics_are_a_grid_with_its_title_legend_and_panels_apart(
+    tmp_path, drawn
+):
+    """A study of one scenario draws its metrics three to a row (not a strip one panel wide),
+    and the title, the legend under it and the panels under both are all inside the figure and
+    overlap nothing."""
+    _study(tmp_path, (Point((("map.eta", 0.5),)), Point((("map.eta", 1.0),))))
+    figure = drawn["metrics-vs-map.eta.png"]
+    panels = figure.axes
+    assert len(panels) > 3
+    assert len({round(axis.get_position().x0, 3) for axis in panels}) == 3
+    assert figure.get_figwidth() == pytest.approx(3 * 4.2)
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    whole = figure.bbox
+    title = figure._suptitle.get_window_extent(renderer)
+    (legend,) = figure.legends
+    key = legend.get_window_extent(renderer)
+    assert whole.x0 <= title.x0 and title.x1 <= whole.x1 and title.y1 <= whole.y1
+    assert key.y1 <= title.y0  # the legend under the title
+    highest = max(axis.get_tightbbox(renderer).y1 for axis in panels)
+    assert highest <= key.y0  # the panels, their titles and labels under the legend
