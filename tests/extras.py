@@ -32,3 +32,16 @@ def embree_available() -> bool:
     if rtcore_scene is None and x86 and os.environ.get("REQUIRE_EXTRAS"):
         pytest.fail("embreex is in the dependencies for x86-64 but does not import")
     return rtcore_scene is not None
+
+
+def require_c_compiler() -> str:
+    """The system C compiler the casadi cache uses, or a skip (a failure under
+    ``REQUIRE_EXTRAS``: CI's machine has one, and without it nothing is compiled)."""
+    from mission.codegen.casadi_cache import c_compiler
+
+    compiler = c_compiler()
+    if compiler is None:
+        if os.environ.get("REQUIRE_EXTRAS"):
+            pytest.fail("no C compiler (gcc or cc) on the path: the casadi cache compiles nothing")
+        pytest.skip("no C compiler: casadi's code is interpreted here")
+    return compiler

@@ -13,10 +13,11 @@ import casadi as ca
 
 from mission.codegen import casadi_cache
 from mission.codegen.casadi_cache import FunctionBuild, NlpBuild, c_compiler
+from mission.codegen.news import Compiling
 
 __all__ = ["COMPILED", "COMPILING", "FunctionBuild", "NlpBuild", "c_compiler"]
 
-SUPPORT_MPC = casadi_cache.Compiling("ground station", "the support MPC", "support_mpc")
+SUPPORT_MPC = Compiling("ground station", "the support MPC", "support_mpc")
 COMPILING = SUPPORT_MPC.starting  # what `mission run` shows of a first run's wait
 COMPILED = SUPPORT_MPC.done
 

@@ -6,7 +6,9 @@ constraints and their derivatives); compiled, they run several times faster than
 interpreter (`interpreted_over_compiled_ratio` in `mission bench`). The first use on a
 machine generates and compiles (every library at once, one compiler process each); later
 ones load the cached libraries and build nothing. Who compiles says so on stderr
-(:class:`Compiling`).
+(:class:`~mission.codegen.news.Compiling`). Processes that want the same libraries at once
+(a ground station and its MPC helper, four vehicles, a study's parallel runs) take turns: one
+compiles, the others wait for it and then load what it cached.
 """
 
 from __future__ import annotations
@@ -16,7 +18,6 @@ import hashlib
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterator
@@ -25,30 +26,7 @@ from pathlib import Path
 
 import casadi as ca
 
-
-@dataclass(frozen=True)
-class Compiling:
-    """Who compiles what: ``who: compiling WHAT with gcc: ...`` on stderr, and the libraries'
-    name prefix in the cache."""
-
-    who: str
-    what: str
-    prefix: str
-
-    @property
-    def starting(self) -> str:
-        """What is said when compiling starts (before `` with COMPILER: ...``)."""
-        return f"compiling {self.what}"
-
-    @property
-    def done(self) -> str:
-        """What is said when it is done (before `` in S s``)."""
-        return f"compiled {self.what}"
-
-    def say(self, text: str) -> None:
-        """One line on stderr."""
-        print(f"{self.who}: {text}", file=sys.stderr, flush=True)
-
+from mission.codegen.news import Compiling
 
 # -O1: as fast a solve as -O2 (1,220 recorded solves, bit-identical results) and the
 # generated ~1.2 MB of C compiles in 5.8 s instead of 8.6 s
@@ -64,6 +42,11 @@ class NlpBuild:
     plugin: str
     nlp: dict[str, ca.MX]
     options: dict
+
+    @property
+    def part(self) -> str:
+        """What it is called when it is compiled."""
+        return self.name
 
     def recipe(self) -> str:
         """What the library is made from (its cache key hashes it)."""
@@ -84,6 +67,11 @@ class FunctionBuild:
     library)``)."""
 
     function: ca.Function
+
+    @property
+    def part(self) -> str:
+        """What it is called when it is compiled."""
+        return self.function.name()
 
     def recipe(self) -> str:
         """What the library is made from (its cache key hashes it)."""
@@ -112,24 +100,64 @@ def compiled_builds(
     libraries: list[str | None] = [None] * len(builds)
     if compiler is None:
         return libraries
-    missing: dict[int, str] = {}
-    for index, build in enumerate(builds):
-        library_name = _library_name(compiler, build, who.prefix)
-        cached = _cache_dir() / library_name
-        if cached.is_file():
-            libraries[index] = str(cached)
-        else:
-            missing[index] = library_name
-    if not missing:
+    names = [_library_name(compiler, build, who.prefix) for build in builds]
+    if _take_cached(names, libraries):
         return libraries
-    started = time.monotonic()
-    who.say(
-        f"{who.starting} with {Path(compiler).name}: once per machine, cached in {_cache_dir()}"
-    )
-    with tempfile.TemporaryDirectory(prefix=f"{who.prefix}-c-") as scratch:
+    with _turn(who.prefix):  # another process compiling the same waits, then finds them
+        if _take_cached(names, libraries):
+            return libraries
+        missing = {index: name for index, name in enumerate(names) if libraries[index] is None}
+        parts = [builds[index].part for index in missing]
+        started = time.monotonic()
+        who.started(parts, Path(compiler).name, str(_cache_dir()))
+        made = _generate_and_compile(compiler, builds, missing, fallback_dir, who.prefix)
+        for index, library in made.items():
+            libraries[index] = library
+        who.finished(parts, time.monotonic() - started)
+    return libraries
+
+
+def _take_cached(names: list[str], libraries: list[str | None]) -> bool:
+    """Fill ``libraries`` with the cached ones of ``names``; whether every one was cached."""
+    for index, name in enumerate(names):
+        cached = _cache_dir() / name
+        if libraries[index] is None and cached.is_file():
+            libraries[index] = str(cached)
+    return all(library is not None for library in libraries)
+
+
+@contextlib.contextmanager
+def _turn(prefix: str) -> Iterator[None]:
+    """This process's turn to compile ``prefix``'s libraries: an exclusive lock on a file in
+    the cache (released by the system if the process dies); no lock where the cache cannot be
+    written."""
+    import fcntl
+
+    try:
+        _cache_dir().mkdir(parents=True, exist_ok=True)
+        lock = (_cache_dir() / f".{prefix}.lock").open("a")
+    except OSError:
+        yield
+        return
+    with lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
+def _generate_and_compile(
+    compiler: str,
+    builds: list[NlpBuild | FunctionBuild],
+    missing: dict[int, str],
+    fallback_dir: Callable[[], str],
+    prefix: str,
+) -> dict[int, str]:
+    """The C of each missing build generated in a scratch directory, then compiled into the
+    cache (or where it cannot be written, ``fallback_dir()``): the libraries made, by index."""
+    made: dict[int, str] = {}
+    with tempfile.TemporaryDirectory(prefix=f"{prefix}-c-") as scratch:
         sources: dict[int, tuple[str, Path]] = {}
         for index, library_name in missing.items():
-            source = f"{who.prefix}_{index}.c"  # its stem must be a C identifier
+            source = f"{prefix}_{index}.c"  # its stem must be a C identifier
             with contextlib.chdir(scratch):  # casadi writes the C file to the working directory
                 builds[index].generate(source)
             sources[index] = (library_name, Path(scratch) / source)
@@ -142,10 +170,9 @@ def compiled_builds(
             except OSError:
                 continue
             for index, library in _compile_all(compiler, sources, directory).items():
-                libraries[index] = library
+                made[index] = library
                 del sources[index]
-    who.say(f"{who.done} in {time.monotonic() - started:.1f} s")
-    return libraries
+    return made
 
 
 @contextlib.contextmanager

@@ -33,20 +33,16 @@ from mission.link.impairment import LinkSettings
 from mission.link.plan_files import vehicle_names
 from mission.procs.atomic import write_text_atomically
 from mission.procs.disk_full import EXIT_NO_SPACE
-from mission.procs.file_tail import FileTail
 from mission.procs.forked import ForkedProcess, fork_is_safe, start_forked
 from mission.procs.interrupts import StopRequest
 from mission.procs.process_life import child_environment
 from mission.procs.provenance import run_provenance
 from mission.procs.stopping import stop_processes
+from mission.runs.compile_relay import CompileRelay, compile_summary
 from mission.runs.stall import DEFAULT_STALL_S, StallWatch
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
 SUPERVISE_S = 0.1  # how often the vehicles are checked while the ground station runs
-# what the ground station says of a first run's compilation (ground_station.support_mpc.nlp_cache's
-# COMPILING and COMPILED, written out here: importing it would import casadi)
-COMPILE_NEWS = ("compiling the support MPC", "compiled the support MPC")
-_COMPILED = re.compile(r"compiled the support MPC in ([\d.]+) s")
 
 
 class RunFailed(RuntimeError):
@@ -232,24 +228,17 @@ def _summary(options: RunOptions, scenario: Scenario, wall: float) -> dict[str, 
     }
     simulated = (summary["control_cycles"] or 0) * scenario.control.t_cont_s
     summary["wall_time_s"] = round(wall, 3)
-    compile_s = _compile_time(options.out_dir / "ground_station.log")
-    if compile_s:  # a first run on this machine compiled the MPC: not the run's pace
+    compiled = compile_summary(options.out_dir / "ground_station.log")
+    compile_s = round(sum(compiled.values()), 1)
+    if compiled:  # a first run on this machine compiled the MPC: not the run's pace
         summary["compile_s"] = compile_s
+        summary["compiled"] = compiled
     flying = wall - compile_s
     summary["realtime_factor"] = round(simulated / flying, 3) if flying > 0 else None
     link_file = options.out_dir / "link.json"
     if link_file.is_file():
         summary["link"] = json.loads(link_file.read_text())
     return summary
-
-
-def _compile_time(log: Path) -> float:
-    """Seconds the ground station spent compiling the support MPC (0: it was cached)."""
-    try:
-        found = _COMPILED.search(log.read_text(encoding="utf-8", errors="replace"))
-    except OSError:
-        return 0.0
-    return float(found.group(1)) if found else 0.0
 
 
 def _vehicle_main(scenario: Scenario) -> Callable[[list[str]], int]:
@@ -328,7 +317,7 @@ def _supervise(
     ends the run with an error, and so does a stall (``stall``: its tlog has not grown for
     its limit). What the ground station says of a first run's compilation is shown as it
     comes; the watcher is polled."""
-    relay = LogRelay(gcs.log, COMPILE_NEWS)
+    relay = CompileRelay(gcs.log)
     while True:
         stop.check()
         try:
@@ -339,8 +328,7 @@ def _supervise(
             relay.poll()
             if watcher is not None:
                 watcher.poll()
-        compiling = relay.said(COMPILE_NEWS[0]) and not relay.said(COMPILE_NEWS[1])
-        if stall is not None and stall.stalled(paused=compiling):
+        if stall is not None and stall.stalled(paused=relay.compiling):
             raise RunFailed(
                 f"stalled: {stall.progress.name} did not grow for {stall.limit_s:g} s of wall "
                 f"time{_why(gcs.log)}"
@@ -355,31 +343,6 @@ def _supervise(
                 raise RunFailed(
                     f"{child.name} died (exit status {child.process.returncode}, see {child.log})"
                 )
-
-
-class LogRelay:
-    """Shows on this process's stderr, once each, the lines of a child's log that start with
-    one of ``prefixes`` (after the child's ``name: ``), reading only what is new."""
-
-    def __init__(self, log: Path, prefixes: tuple[str, ...]) -> None:
-        self.log = log
-        self.pending = list(prefixes)
-        self._file = FileTail(log)
-
-    def said(self, prefix: str) -> bool:
-        """Whether a line starting with ``prefix`` (one of the prefixes) has been shown."""
-        return prefix not in self.pending
-
-    def poll(self) -> None:
-        """Show what has come since the last poll."""
-        if not self.pending:
-            return
-        for line in self._file.new_lines():
-            text = line.decode("utf-8", "replace").split(": ", 1)[-1]
-            for prefix in list(self.pending):
-                if text.startswith(prefix):
-                    print(text, file=sys.stderr, flush=True)
-                    self.pending.remove(prefix)
 
 
 def _stop_all(children: list[Child]) -> None:

@@ -19,7 +19,7 @@ from mission.studies.spec import StudySpec
 _LEADING = ["scenario", "point", "method", "seed"]
 _TRAILING = ["wall_time_s", "node", "run_key"]
 _SKIPPED = {"scenario", "method", "seed", "scenario_source", "study", "link_events", "link"}
-_SKIPPED |= {"cpu_s"}  # the machine's, like the wall time, and not a metric of the run
+_SKIPPED |= {"cpu_s", "compiled"}  # the machine's, like the wall time: no metric of the run
 _SKIPPED |= {"provenance"}  # the code's and the machine's: the study's provenance.json
 
 

@@ -9,8 +9,8 @@ from ground_station.control.work_mpc import predict_work
 from ground_station.estimation.gnss_map import LocalizabilityMap, hermite_zero_slope
 from ground_station.support_mpc.branches import CONVERGED
 from ground_station.support_mpc.mpc import SupportMpc
-from ground_station.support_mpc.nlp_cache import c_compiler
 from mission.link.plan_files import read_plan
+from tests.extras import require_c_compiler
 
 
 def test_work_mpc_steps_greedily_and_advances_the_index():
@@ -245,8 +245,7 @@ def test_an_mpc_compiled_outside_the_cache_leaves_no_files_behind(
     control = along_world.scenario.control
     mpc = SupportMpc(control, along_world.map_grid(), along_world.camera)
     assert list(scratch.iterdir()) == []
-    if c_compiler() is None:
-        return
+    require_c_compiler()
     plan = read_plan(along_world.scenario)
     work = predict_work(
         plan.work[3], 4, plan.work, control.horizon_steps, control.d_max_work_m, 0.1

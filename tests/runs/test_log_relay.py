@@ -10,49 +10,73 @@ import time
 import pytest
 
 from ground_station.support_mpc import nlp_cache
-from mission.runs.orchestrator import COMPILE_NEWS, LogRelay
+from mission.runs.compile_relay import CompileRelay, compile_summary
+
+STARTED = "compiling the support MPC (support_mpc_near, support_mpc_far) with gcc: once per machine"
+DONE = "compiled the support MPC (support_mpc_near, support_mpc_far) in 9.5 s"
 
 
-def test_the_news_are_the_ground_stations_own_words():
-    assert COMPILE_NEWS == (nlp_cache.COMPILING, nlp_cache.COMPILED)
+def test_the_relay_knows_the_ground_stations_own_words(tmp_path, capsys):
+    log = tmp_path / "ground_station.log"
+    log.write_text("")
+    nlp_cache.SUPPORT_MPC.started(["margin_half_spaces"], "gcc", "/cache")
+    nlp_cache.SUPPORT_MPC.finished(["margin_half_spaces"], 2.31)
+    log.write_text(capsys.readouterr().err)
+    relay = CompileRelay(log)
+    relay.poll()
+    assert capsys.readouterr().err.splitlines() == [
+        "compiling the support MPC (margin_half_spaces) with gcc: once per machine, "
+        "cached in /cache",
+        "compiled the support MPC (margin_half_spaces) in 2.3 s",
+    ]
+    assert compile_summary(log) == {"the support MPC (margin_half_spaces)": 2.3}
 
 
-def test_each_news_line_is_shown_once_and_only_when_whole(tmp_path, capsys):
+def test_every_compile_line_is_shown_when_whole_and_counted_until_done(tmp_path, capsys):
     log = tmp_path / "ground_station.log"
     log.write_text("ground station listening on 127.0.0.1:5\n")
-    relay = LogRelay(log, COMPILE_NEWS)
+    relay = CompileRelay(log)
     relay.poll()
-    assert capsys.readouterr().err == ""
+    assert capsys.readouterr().err == "" and not relay.compiling
     with log.open("a") as handle:
-        handle.write(f"ground station: {COMPILE_NEWS[0]} with gcc: once per machine\n")
-        handle.write(f"ground station: {COMPILE_NEWS[0]} with gcc: once per machine\n")  # helper
-        handle.write(f"ground station: {COMPILE_NEWS[1]} in 9")  # not a whole line yet
+        handle.write(f"ground station: {STARTED}\n")
+        handle.write("ground station: compiled the support MPC (margin_half_spaces) in 2.0 s\n")
+        handle.write(f"ground station: {STARTED}\n")
+        handle.write(f"ground station: {DONE[:-5]}")  # not a whole line yet
     relay.poll()
-    assert capsys.readouterr().err == f"{COMPILE_NEWS[0]} with gcc: once per machine\n"
+    assert capsys.readouterr().err.splitlines() == [
+        STARTED,
+        "compiled the support MPC (margin_half_spaces) in 2.0 s",
+        STARTED,
+    ]
+    assert relay.compiling
     with log.open("a") as handle:
-        handle.write(".5 s\n")
+        handle.write(DONE[-5:] + "\n")
     relay.poll()
     relay.poll()
-    assert capsys.readouterr().err == f"{COMPILE_NEWS[1]} in 9.5 s\n"
+    assert capsys.readouterr().err == f"{DONE}\n" and not relay.compiling
 
 
 def test_a_missing_log_is_no_news(tmp_path, capsys):
-    LogRelay(tmp_path / "none.log", COMPILE_NEWS).poll()
+    CompileRelay(tmp_path / "none.log").poll()
     assert capsys.readouterr().err == ""
 
 
-def test_a_first_runs_compile_time_is_read_from_the_ground_stations_log(tmp_path):
-    from mission.runs.orchestrator import _compile_time
-
+def test_a_first_runs_compilations_are_read_from_the_ground_stations_log(tmp_path):
     log = tmp_path / "ground_station.log"
     log.write_text(
         "ground station listening on 127.0.0.1:5000\n"
-        "ground station: compiling the support MPC with gcc: once per machine, cached\n"
-        "ground station: compiled the support MPC in 26.3 s\n"
+        "ground station: compiling the support MPC (margin_half_spaces) with gcc: once, cached\n"
+        "ground station: compiled the support MPC (margin_half_spaces) in 2.3 s\n"
+        f"ground station: {STARTED}, cached\n"
+        "ground station: compiled the support MPC (support_mpc_near, support_mpc_far) in 26.3 s\n"
     )
-    assert _compile_time(log) == 26.3  # left out of the run's real-time factor
+    assert compile_summary(log) == {  # each left out of the run's real-time factor
+        "the support MPC (margin_half_spaces)": 2.3,
+        "the support MPC (support_mpc_near, support_mpc_far)": 26.3,
+    }
     log.write_text("ground station listening on 127.0.0.1:5000\n")
-    assert _compile_time(log) == 0.0 and _compile_time(tmp_path / "none.log") == 0.0
+    assert compile_summary(log) == {} and compile_summary(tmp_path / "none.log") == {}
 
 
 def test_a_tlog_that_stops_growing_stalls_unless_the_mpc_is_compiling(tmp_path):

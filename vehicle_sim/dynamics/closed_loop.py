@@ -15,7 +15,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from mission.codegen.casadi_cache import Compiling, compiled_function
+from mission.codegen.casadi_cache import compiled_function
+from mission.codegen.news import Compiling
 from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
 from vehicle_sim.dynamics.autopilot_loops import motor_commands
 from vehicle_sim.dynamics.rigid_body import (
