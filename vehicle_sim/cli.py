@@ -295,7 +295,7 @@ def _identity(name: str) -> VehicleIdentity:
 
 def _address(text: str, flag: str):
     try:
-        return parse_address(text, flag)
+        return parse_address(text)
     except ValueError as error:
         raise InputError("command line", flag, str(error)) from None
 

@@ -160,7 +160,7 @@ def _check_flags(args: argparse.Namespace) -> None:
         from mission.link.mavlink_udp import parse_address
 
         try:
-            parse_address(args.observer, "--observer")
+            parse_address(args.observer)
         except ValueError as error:
             raise InputError("command line", "--observer", str(error)) from None
     if args.out is not None:

@@ -305,7 +305,7 @@ FILE_CASES = [
     (
         "yaml-syntax",
         lambda t: [*RUN, str(scenario_file(t, "control: {horizon_steps: [\n"))],
-        ["bad.yaml"],
+        ["bad.yaml", "invalid YAML"],
     ),
     (
         "yaml-not-a-mapping",
@@ -350,22 +350,22 @@ FILE_CASES = [
     (
         "extends-missing",
         lambda t: [*RUN, str(raw_file(t, "extends: nowhere.yaml\nname: x\n"))],
-        ["nowhere"],
+        ["nowhere", "extends: no such scenario file"],
     ),
     (
         "extends-itself",
         lambda t: [*RUN, str(raw_file(t, "extends: raw.yaml\nname: x\n"))],
-        ["raw.yaml"],
+        ["raw.yaml", "extends: too deep (is there a cycle?)"],
     ),
     (
         "mesh-missing",
         lambda t: [*RUN, str(scenario_file(t, "world: {structure: {mesh_file: gone.stl}}\n"))],
-        ["gone.stl"],
+        ["gone.stl", "world.structure.mesh_file: no such file"],
     ),
     (
         "mesh-garbage",
         lambda t: [*RUN, str(mesh_file(t, b"\x00\x01not a mesh at all" * 3))],
-        ["junk.stl"],
+        ["junk.stl", "holds no triangles"],
     ),
     (
         "mesh-no-normal",
@@ -395,7 +395,7 @@ FILE_CASES = [
     (
         "mesh-no-faces",
         lambda t: [*RUN, str(mesh_file(t, b"v 0 0 0\nv 1 0 0\n", "flat.obj"))],
-        ["flat.obj"],
+        ["flat.obj", "holds no triangles"],
     ),
     # --- what a run would ask of the machine --------------------------------------------------
     (
@@ -469,11 +469,15 @@ FILE_CASES = [
     (
         "plan-dir-missing",
         lambda t: [*RUN, str(scenario_file(t, "task: {waypoints_dir: nowhere}\n"))],
-        ["nowhere"],
+        ["nowhere/work.waypoints", "no waypoint file for work"],
     ),
     # --- waypoint files ----------------------------------------------------------------
     ("wpl-header", lambda t: wpl_args(t, "QGC WPL 100\n" + GOOD_ROW), ["work.waypoints", "line 1"]),
-    ("wpl-empty", lambda t: wpl_args(t, ""), ["work.waypoints"]),
+    (
+        "wpl-empty",
+        lambda t: wpl_args(t, ""),
+        ["work.waypoints", "first line must be 'QGC WPL 110'"],
+    ),
     (
         "wpl-columns",
         lambda t: wpl_args(t, HEADER + "\n" + GOOD_ROW + "2\t0\t3\n"),
