@@ -45,6 +45,10 @@ def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
         f"paper's form decides; if it is meant, LOCKSTEP_DECISIONS = {digest!r}"
     )
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    # what the digest pins, in the run's own terms (they say what moved when the digest does)
+    assert (summary["completion_time_s"], summary["control_cycles"]) == (28.0, 56)
+    assert summary["multipath_steps"] == {"support-1": 0, "support-2": 56, "support-3": 0}
+    assert summary["work_error_m"] == {"mean": 0.1725, "p95": 0.335, "max": 0.6409}
     assert summary["mode"] == "lockstep" and summary["speedup"] is None
     assert summary["measurement_age_ms"] == {"median": 0.0, "p95": 0.0, "max": 0.0}
 

@@ -31,7 +31,8 @@ run: {{stop_on_crash: {stop}}}
 # Along AC seed 0 in the paper's form: its cycles and the digest of its decisions
 # (mission.analysis.decisions: every record but its wall-clock fields, numbers to 1e-6), the
 # same whatever SIMD numpy and OpenBLAS use. A change that means to alter the paper's form
-# says so by updating it.
+# says so by updating it. The digest holds every decision of the run at once; the test also
+# states the run's outcome in its own terms, which say what moved when the digest does.
 PAPER_FORM_DECISIONS = (509, "d20f4eb6c1d54842")
 
 
@@ -49,6 +50,13 @@ def test_the_papers_form_is_one_setting_away(tmp_path):
     assert (len(records), decisions_digest(records)) == PAPER_FORM_DECISIONS
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert summary["decisions_digest"] == PAPER_FORM_DECISIONS[1]
+    # what the digest pins, in the terms a reader of the run sees: where a change moved the
+    # digest, these say first what moved
+    assert (summary["completion_time_s"], summary["multipath_steps"]) == (
+        254.5,
+        {"support-1": 13, "support-2": 1, "support-3": 0},
+    )
+    assert summary["work_error_m"] == {"mean": 0.1408, "p95": 0.2686, "max": 0.6355}
     safety = summary["safety"]
     # without margins support-1 flies into the deck's edge and on: recorded, not stopped
     assert safety["contacts"] and not any(c["crash"] for c in safety["contacts"])
