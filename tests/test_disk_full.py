@@ -70,7 +70,7 @@ def test_a_run_on_a_full_disk(small_disk, room):
 
 def test_a_study_on_a_full_disk(small_disk):
     _fill(small_disk, 16_000)
-    study = str(ROOT / "studies" / "smoke.yaml")
+    study = str(ROOT / "mission" / "studies" / "shipped" / "smoke.yaml")
     line = _refused(small_disk, "study", study, "--out", str(small_disk / "s"))
     assert str(small_disk / "s") in line
 

@@ -20,7 +20,12 @@ def add_parser(commands) -> None:
         help="run a study file (a sweep of scenarios x points x methods x seeds); "
         "write results.csv and report.md",
     )
-    parser.add_argument("file", type=Path, metavar="FILE.yaml", help="the study file")
+    parser.add_argument(
+        "file",
+        type=Path,
+        metavar="STUDY",
+        help="a study file, or a shipped study's name (smoke, table3, ...)",
+    )
     parser.add_argument(
         "--engine",
         choices=["local", "ray"],

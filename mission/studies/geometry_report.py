@@ -1,7 +1,7 @@
 """What a study whose multipath comes from geometry says beyond its report, from
 its kept runs::
 
-    python -m mission.studies.geometry_report studies/river.yaml STUDY_OUT [--figure F.png]
+    python -m mission.studies.geometry_report river STUDY_OUT [--figure F.png]
 
 - **Does G learn the right places?** Per scenario, point and method, the mean over runs of
   G's and the prior's agreement with the true error field on the voxels the run taught

@@ -1,7 +1,7 @@
 """What G learned in each run of a study (:mod:`mission.analysis.map_learning`), as a table
 per scenario, point and method::
 
-    python -m mission.studies.map_learning studies/faults.yaml STUDY_OUT
+    python -m mission.studies.map_learning faults STUDY_OUT
 
 where ``STUDY_OUT`` is the study's ``--out`` folder with its run folders (``runs/``; the
 committed ``docs/studies/*`` hold no run folders).

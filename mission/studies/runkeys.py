@@ -27,6 +27,7 @@ _RUN_CODE = (
     "mission/procs",
     "mission/analysis",
     "mission/scenarios",
+    "mission/codegen",
     "mission/runs/orchestrator.py",
 )
 

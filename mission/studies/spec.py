@@ -27,6 +27,7 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -166,6 +167,7 @@ def _speedup(source: str, value: Any) -> float | None:
 def load_study(path: Path, say: Callable[[str], None] | None = None) -> StudySpec:
     """Read and validate a study file (every scenario at every point included); ``say`` is
     told, before a long check of the points starts, how many there are."""
+    path = shipped_study(path) or path
     source = str(path)
     size = path.stat().st_size if path.is_file() else 0
     if say is not None and size > ANNOUNCED_BYTES:
@@ -248,8 +250,27 @@ def validate_points(spec: StudySpec) -> dict[tuple[str, int], Scenario]:
     return resolved
 
 
+def shipped_studies_dir() -> Path:
+    """Where the studies shipped inside the package are (docs/studies holds their results)."""
+    return Path(str(resources.files("mission.studies") / "shipped"))
+
+
+def shipped_study_names() -> list[str]:
+    """The names of the shipped studies, as ``mission study NAME`` takes them."""
+    return sorted(p.stem for p in shipped_studies_dir().glob("*.yaml"))
+
+
+def shipped_study(reference: Path) -> Path | None:
+    """The shipped study a bare name (no folder, no suffix, not a file here) stands for."""
+    if reference.is_file() or reference.suffix or len(reference.parts) != 1:
+        return None
+    candidate = shipped_studies_dir() / f"{reference.name}.yaml"
+    return candidate if candidate.is_file() else None
+
+
 def _missing(path: Path) -> dict[str, Any]:
-    raise InputError(str(path), "", "no such study file")
+    shipped = ", ".join(shipped_study_names())
+    raise InputError(str(path), "", f"no such study file or shipped study (shipped: {shipped})")
 
 
 def _known() -> str:

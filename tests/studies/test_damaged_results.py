@@ -72,7 +72,7 @@ def test_a_damaged_results_file_is_refused_and_nothing_rewritten(tmp_path, capsy
     results = study / "results.csv"
     results.write_bytes(damage(results.read_bytes()))
     before = {p: p.read_bytes() for p in sorted(study.rglob("*")) if p.is_file()}
-    spec = str(ROOT / "studies" / "table3.yaml")
+    spec = str(ROOT / "mission" / "studies" / "shipped" / "table3.yaml")
     status = mission_cli.entry_point(["study", spec, "--out", str(study), "--report-only"])
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
@@ -82,7 +82,7 @@ def test_a_damaged_results_file_is_refused_and_nothing_rewritten(tmp_path, capsy
 
 
 def test_rows_in_another_order_give_the_same_report(tmp_path):
-    spec = str(ROOT / "studies" / "table3.yaml")
+    spec = str(ROOT / "mission" / "studies" / "shipped" / "table3.yaml")
     made = {}
     for name, order in (("as-made", lambda rows: rows), ("reversed", lambda rows: rows[::-1])):
         study = tmp_path / name

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from mission.config.errors import InputError
-from mission.studies.spec import load_study
+from mission.studies.spec import load_study, shipped_studies_dir, shipped_study_names
 
 
 def _write(tmp_path: Path, text: str, name: str = "study.yaml") -> Path:
@@ -54,8 +54,10 @@ ONE_METHOD = {"ceiling": "the question is the deck's distance, not the method"}
 
 
 def test_every_shipped_study_is_valid():
-    root = Path(__file__).resolve().parents[2] / "studies"
-    names = sorted(p.stem for p in root.glob("*.yaml"))
+    root = Path(__file__).resolve().parents[2] / "mission" / "studies" / "shipped"
+    assert shipped_studies_dir() == root
+    names = shipped_study_names()
+    assert names == sorted(p.stem for p in root.glob("*.yaml"))
     assert {"smoke", "table3", "fusion-leakage", "work-speed"} <= set(names)
     for path in root.glob("*.yaml"):
         spec = load_study(path)
@@ -215,3 +217,14 @@ def test_a_study_of_many_runs_or_a_long_file_says_so_before_the_slow_part(tmp_pa
     said.clear()
     load_study(long, say=said.append)
     assert said[0].startswith(f"reading {long} (1.") and said[0].endswith(" MB)")
+
+
+def test_a_shipped_study_is_named_as_a_scenario_is(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # outside the checkout: found in the package, not here
+    assert load_study(Path("smoke")).source == shipped_studies_dir() / "smoke.yaml"
+    (tmp_path / "smoke").write_text("scenarios: [wall]\nname: mine\n")
+    assert load_study(Path("smoke")).name == "mine"  # a file of that name here comes first
+    with pytest.raises(
+        InputError, match=r"nosuch: no such study file or shipped study \(shipped: .*smoke"
+    ):
+        load_study(Path("nosuch"))
