@@ -39,6 +39,7 @@ from mission.procs.process_life import child_environment
 from mission.procs.provenance import run_provenance
 from mission.procs.stopping import stop_processes
 from mission.runs.compile_relay import CompileRelay, compile_summary
+from mission.runs.progress import RunProgress
 from mission.runs.stall import DEFAULT_STALL_S, StallWatch
 
 _BANNER = re.compile(r"listening on [\d.]+:(\d+)")
@@ -107,7 +108,11 @@ def run_mission(
             try:
                 gcs = _start_processes(options, scenario, children)
                 stall = StallWatch(options.out_dir / "gcs.tlog", options.stall_s)
-                _supervise(gcs, children, {"work"}, watcher, stop, stall)
+                progress = None
+                if RunProgress.wanted():
+                    records = options.out_dir / "records.jsonl"
+                    progress = RunProgress(records, scenario.run.timeout_s)
+                _supervise(gcs, children, {"work"}, watcher, stop, stall, progress)
                 if gcs.process.returncode == EXIT_NO_SPACE:  # its files could not be written
                     full = errno.ENOSPC
                     raise OSError(full, os.strerror(full), str(options.out_dir / "gcs.tlog"))
@@ -312,12 +317,22 @@ def _supervise(
     watcher: RunWatcher | None,
     stop: StopRequest,
     stall: StallWatch | None = None,
+    progress: RunProgress | None = None,
 ) -> None:
     """Wait for the ground station; a dead required vehicle, or one that never started,
     ends the run with an error, and so does a stall (``stall``: its tlog has not grown for
     its limit). What the ground station says of a first run's compilation is shown as it
-    comes; the watcher is polled."""
+    comes, and on a terminal how far the run has got (``progress``); the watcher is polled."""
     relay = CompileRelay(gcs.log)
+    try:
+        _watch(gcs, children, required, watcher, stop, stall, relay, progress)
+    finally:
+        if progress is not None:
+            progress.clear()
+
+
+def _watch(gcs, children, required, watcher, stop, stall, relay, progress) -> None:
+    """:func:`_supervise`'s loop."""
     while True:
         stop.check()
         try:
@@ -326,6 +341,8 @@ def _supervise(
             return
         except subprocess.TimeoutExpired:
             relay.poll()
+            if progress is not None:
+                progress.poll()
             if watcher is not None:
                 watcher.poll()
         if stall is not None and stall.stalled(paused=relay.compiling):
