@@ -14,6 +14,9 @@ from mission.link.waypoints import WaypointRow, read_waypoints, row_position_enu
 from mission.world.frames import GeodeticFrame
 from mission.world.model import KnownWorld
 
+# a planned file that does not fit the scenario (its structure or its path changed since)
+PLAN_AGAIN = "; plan it again (python -m mission plan SCENARIO)"
+
 
 def check_plan_files(world: KnownWorld, directory: Path, names: Sequence[str]) -> None:
     """Each vehicle's ``<name>.waypoints`` in ``directory``: home and at least one waypoint,
@@ -65,7 +68,8 @@ def _check_margins(world: KnownWorld, directory: Path, positions: dict[str, np.n
                     f"{gaps[worst]:.2f} m from the structure or the ground, less than "
                     f"control.clearance_m ({control.clearance_m:g} m)"
                 )
-                raise InputError(str(directory / f"{name}.waypoints"), f"item {worst + 1}", problem)
+                path = str(directory / f"{name}.waypoints")
+                raise InputError(path, f"item {worst + 1}", problem + PLAN_AGAIN)
     if control.min_separation_m > 0:
         names = list(positions)
         for i, first in enumerate(names):
@@ -92,7 +96,7 @@ def _check_row(world: KnownWorld, frame: GeodeticFrame, path: Path, row: Waypoin
     shown = [round(float(v), 2) for v in position]
     problem = world.placement_problem(position)
     if problem is not None:
-        raise InputError(str(path), where, f"{shown} (ENU) lies {problem}")
+        raise InputError(str(path), where, f"{shown} (ENU) lies {problem}{PLAN_AGAIN}")
 
 
 def check_work_waypoints_clear(world: KnownWorld) -> None:
@@ -133,7 +137,7 @@ def check_work_plan_matches(world: KnownWorld, directory: Path) -> None:
     path = Path(directory) / "work.waypoints"
     flown = read_vehicle_waypoints(scenario, "work")
     wanted = np.asarray(scenario.task.work_waypoints_m, dtype=float)
-    again = "; plan it again (python -m mission plan SCENARIO)"
+    again = PLAN_AGAIN
     if len(flown) != len(wanted):
         problem = f"{len(flown)} waypoints, the scenario's task.work_waypoints_m {len(wanted)}"
         raise InputError(str(path), "", problem + again)

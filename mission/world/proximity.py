@@ -3,14 +3,15 @@ clear of them: what contact detection (the vehicles) and the MPCs' margins (the 
 share.
 
 The structure is a set of convex pieces: each box primitive (distances in closed form, signed:
-negative inside), and a mesh file as one more piece (trimesh's closest points, unsigned; a
-watertight file's inside counts as negative). The ground is the plane z = 0.
+negative inside), and each connected part of a mesh file (trimesh's closest points, unsigned; a
+watertight part's inside counts as negative), so that a mesh of the same bodies as the boxes
+gives the same pieces. The ground is the plane z = 0.
 
 A *separating half-space* of a point g from a convex piece is {x : n.x >= n.c}, c the piece's
 point closest to g and n the unit vector from c to g (inside a box, the normal of the face it is
 nearest to). The piece lies wholly on the other side, so any x with n.x >= n.c + m is at least
-m from the piece: a linear constraint that is conservative, never optimistic (for a mesh file,
-which need not be convex, it holds near c only).
+m from the piece: a linear constraint that is conservative, never optimistic (for a part of a
+mesh file that is not convex, it holds near c only).
 """
 
 from __future__ import annotations
@@ -26,8 +27,7 @@ class StructureProximity:
     def __init__(self, structure: Structure) -> None:
         self.low, self.high = structure.box_low, structure.box_high
         self._file_mesh = structure.file_mesh
-        if self._file_mesh is not None:
-            self._file_solid = structure.solid_file_mesh
+        self._parts = [] if self._file_mesh is None else mesh_parts(self._file_mesh)
 
     @property
     def has_file_mesh(self) -> bool:
@@ -36,8 +36,8 @@ class StructureProximity:
 
     @property
     def pieces(self) -> int:
-        """How many convex pieces (boxes, and the mesh file as one)."""
-        return len(self.low) + (self._file_mesh is not None)
+        """How many pieces: the boxes, and the connected parts of the mesh file."""
+        return len(self.low) + len(self._parts)
 
     def closest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per point and piece: the signed distance (points, pieces), the closest point on the
@@ -74,18 +74,18 @@ class StructureProximity:
             np.put_along_axis(projected, axis[..., None], face[..., None], axis=2)
             normals = np.where(inside[..., None], face_normals, normals)
             closest = np.where(inside[..., None], projected, closest)
-        if self._file_mesh is not None:
-            on_mesh, gap, _ = self._file_mesh.nearest.on_surface(points)
-            direction = points - on_mesh
+        for part, solid in self._parts:
+            on_part, gap, _ = part.nearest.on_surface(points)
+            direction = points - on_part
             normal = np.divide(
                 direction, gap[:, None], out=np.zeros_like(direction), where=gap[:, None] > 0
             )
-            if self._file_solid is not None:
-                within = self._file_solid.contains(points)
+            if solid:
+                within = part.contains(points)
                 gap = np.where(within, -gap, gap)
                 normal = np.where(within[:, None], -normal, normal)
             distance = np.column_stack([distance, gap])
-            closest = np.concatenate([closest, on_mesh[:, None]], axis=1)
+            closest = np.concatenate([closest, on_part[:, None]], axis=1)
             normals = np.concatenate([normals, normal[:, None]], axis=1)
         return distance, closest, normals
 
@@ -101,6 +101,15 @@ class StructureProximity:
         """Distance from each point to whatever is nearer, the structure or the ground."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         return np.minimum(self.distance(points), points[:, 2])
+
+
+def mesh_parts(mesh) -> list[tuple[object, bool]]:
+    """The connected parts of a mesh (triangles sharing a vertex, once coincident vertices are
+    merged), each with whether it is watertight (it has an inside)."""
+    merged = mesh.copy()
+    merged.merge_vertices()
+    parts = merged.split(only_watertight=False)
+    return [(part, bool(part.is_watertight)) for part in parts]
 
 
 def segment_points(start: np.ndarray, end: np.ndarray, spacing_m: float) -> np.ndarray:

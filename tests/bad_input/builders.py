@@ -84,6 +84,17 @@ def mesh_file(tmp: Path, content: bytes, name: str = "junk.stl") -> Path:
     return scenario_file(tmp, f"world: {{{reflecting}{structure}}}\n")
 
 
+def low_deck_scenario(tmp: Path) -> Path:
+    """Along under a deck from 6.5 to 9 m (the default bridge's is 8-9 m), as an OBJ file,
+    its work path moved below it to 5 m: the shipped plan's waypoints at 7 m lie inside."""
+    import trimesh
+
+    deck = trimesh.creation.box(bounds=[(-20.0, -5.0, 6.5), (20.0, 5.0, 9.0)])
+    (tmp / "deck.obj").write_text(trimesh.exchange.obj.export_obj(deck))
+    structure = "world: {structure: {mesh_file: deck.obj, primitives: []}}\n"
+    return scenario_file(tmp, structure + "task: {work_waypoints_m: [[-12, -3, 5], [0, -3, 5]]}\n")
+
+
 def wpl_args(tmp: Path, content: str) -> list[str]:
     plan = plan_dir(tmp, "work", content)
     return [*RUN, str(scenario_file(tmp, f"task: {{waypoints_dir: {plan.name}}}\n"))]

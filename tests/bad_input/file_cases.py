@@ -12,6 +12,7 @@ from tests.bad_input.builders import (
     RAISED_LIMIT,
     RUN,
     TWO_ZONES,
+    low_deck_scenario,
     mesh_file,
     plan_dir,
     raw_file,
@@ -396,6 +397,11 @@ FILE_CASES = [
         "mesh-no-faces",
         lambda t: [*RUN, str(mesh_file(t, b"v 0 0 0\nv 1 0 0\n", "flat.obj"))],
         ["flat.obj", "holds no triangles"],
+    ),
+    (  # a new structure whose deck sits where the shipped plan flies: plan again
+        "mesh-over-the-plan",
+        lambda t: [*RUN, str(low_deck_scenario(t))],
+        ["work.waypoints", "lies inside the structure", "plan it again (python -m mission plan"],
     ),
     # --- what a run would ask of the machine --------------------------------------------------
     (

@@ -62,3 +62,33 @@ def test_segment_points_are_at_most_the_spacing_apart_and_include_both_ends():
     points = segment_points(np.zeros(3), np.array([1.0, 0.0, 0.0]), 0.3)
     assert np.array_equal(points[0], np.zeros(3)) and np.array_equal(points[-1], [1.0, 0, 0])
     assert np.diff(points[:, 0]).max() <= 0.3
+
+
+def test_a_mesh_of_the_boxes_bodies_gives_the_same_pieces(along_world, tmp_path):
+    """Each connected part of a mesh file is a piece, as each box is: the default bridge
+    written as an STL has three, with the boxes' distances, closest points and normals, inside
+    (watertight parts are signed) and out."""
+    from mission.config.scenario import load_scenario
+    from mission.world.model import World
+
+    parts = [trimesh.creation.box(bounds=[b.min_m, b.max_m]) for b in along_world.structure.boxes]
+    stl = tmp_path / "bridge.stl"
+    trimesh.util.concatenate(parts).export(stl)
+    overrides = {"world.structure.mesh_file": str(stl), "world.structure.primitives": []}
+    mesh = StructureProximity(World(load_scenario("along", overrides)).structure)
+    boxes = StructureProximity(along_world.structure)
+    assert mesh.pieces == boxes.pieces == 3
+    rng = np.random.default_rng(1)
+    deck = along_world.structure.boxes[0]
+    inside = rng.uniform(np.array(deck.min_m) + 0.01, np.array(deck.max_m) - 0.01, (50, 3))
+    points = np.vstack([rng.uniform([-25, -20, 0], [25, 20, 20], (2000, 3)), inside])
+    # the pieces in the order of their distance (a mesh's parts come in their own order)
+    by_distance = [_by_distance(*p.closest(points)) for p in (mesh, boxes)]
+    for ours, theirs in zip(*by_distance, strict=True):
+        np.testing.assert_allclose(ours, theirs, atol=1e-9)
+
+
+def _by_distance(distance, closest, normals):
+    order = np.argsort(distance, axis=1)
+    rows = np.arange(len(distance))[:, None]
+    return distance[rows, order], closest[rows, order], normals[rows, order]
