@@ -1,4 +1,4 @@
-"""The mission microservice, ground-station side: upload and download with timeouts/retries."""
+"""The mission microservice, ground-station side: upload with timeouts and retries."""
 
 from __future__ import annotations
 
@@ -61,40 +61,6 @@ class MissionClient:
             item = items[reply.seq]
             last_sent = item.to_int_message((self.system_id, 1))
             self._send(last_sent)
-
-    def download(self) -> list[MissionItem]:
-        """Fetch the vehicle's mission."""
-        reply = self._exchange(
-            mavlink2.MAVLink_mission_request_list_message(self.system_id, 1, MISSION),
-            {"MISSION_COUNT"},
-        )
-        items = []
-        for seq in range(int(reply.count)):
-            item = self._exchange(
-                mavlink2.MAVLink_mission_request_int_message(self.system_id, 1, seq, MISSION),
-                {"MISSION_ITEM_INT"},
-                seq=seq,
-            )
-            items.append(MissionItem.from_message(item))
-        self._send(
-            mavlink2.MAVLink_mission_ack_message(
-                self.system_id, 1, mavlink2.MAV_MISSION_ACCEPTED, MISSION
-            )
-        )
-        return items
-
-    def _exchange(self, request: Any, wanted: set[str], seq: int | None = None) -> Any:
-        for _ in range(self.retries + 1):
-            self._send(request)
-            reply = self._wait(wanted | {"MISSION_ACK"}, seq)
-            if reply is None:
-                continue
-            if reply.get_type() == "MISSION_ACK":
-                raise MissionTransferError(
-                    f"system {self.system_id} refused the download (result {reply.type})"
-                )
-            return reply
-        raise MissionTransferError(f"system {self.system_id}: download timed out")
 
     def _send(self, message: Any) -> None:
         packet = self.endpoint.send(message, [self.vehicle])

@@ -6,7 +6,6 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 MISSION = mavlink2.MAV_MISSION_TYPE_MISSION
@@ -127,8 +126,3 @@ def check_item(item: MissionItem) -> int:
         if math.isinf(value):
             return mavlink2.MAV_MISSION_INVALID
     return mavlink2.MAV_MISSION_ACCEPTED
-
-
-def float32_decimal(value: float) -> float:
-    """The shortest decimal that a float32 field value came from (20.123, not 20.1229991...)."""
-    return float(str(np.float32(value)))

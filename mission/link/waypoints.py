@@ -16,11 +16,8 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.config.errors import InputError, read_text_file
 from mission.link.mission_items import (
     COMMON_FIELDS,
-    FLOAT32_FIELDS,
     GLOBAL_FRAMES,
     MissionItem,
-    float32_decimal,
-    from_int_field,
     to_int_field,
 )
 from mission.procs.atomic import write_text_atomically
@@ -69,14 +66,6 @@ class WaypointRow:
         common = {name: getattr(self, name) for name, _ in COMMON_FIELDS}
         x, y = to_int_field(self.x, self.frame), to_int_field(self.y, self.frame)
         return MissionItem(**common, x=x, y=y)
-
-    @classmethod
-    def from_item(cls, item: MissionItem) -> WaypointRow:
-        """From a downloaded item; float32 fields become the decimals they were written as."""
-        common = {name: getattr(item, name) for name, _ in COMMON_FIELDS}
-        common.update((name, float32_decimal(common[name])) for name in FLOAT32_FIELDS)
-        x, y = from_int_field(item.x, item.frame), from_int_field(item.y, item.frame)
-        return cls(**common, x=x, y=y)
 
 
 def format_waypoints(rows: list[WaypointRow]) -> str:

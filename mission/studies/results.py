@@ -50,6 +50,12 @@ def results_csv(spec: StudySpec, rows: list[dict]) -> str:
     for row in rows:
         columns += [k for k in row if k not in columns and k not in _TRAILING]
     columns += _TRAILING
+    return csv_text(rows, columns)
+
+
+def csv_text(rows: list[dict], columns: list[str]) -> str:
+    """Rows as CSV text with these columns, a missing or None value as an empty cell (what
+    :func:`read_cell` reads back as None)."""
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
     writer.writeheader()

@@ -8,8 +8,6 @@ the seeds both completed).
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import statistics
 from collections.abc import Iterable
@@ -19,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from mission.procs.atomic import write_atomically, write_text_atomically
+from mission.studies.results import csv_text
 from mission.studies.stats import WILCOXON_METHOD, wilcoxon_p
 
 
@@ -125,7 +124,7 @@ def write_tables(out_dir: Path, rows: list[dict]) -> None:
     """(Re)write table.md, table.csv and boxplots.png from a study's result rows."""
     table = table_rows(rows)
     columns = list(table[0]) if table else ["scenario", "method", "runs"]
-    write_text_atomically(out_dir / "table.csv", _csv(table, columns))
+    write_text_atomically(out_dir / "table.csv", csv_text(table, columns))
     write_text_atomically(out_dir / "table.md", table_markdown(table))
     if rows:
         write_atomically(out_dir / "boxplots.png", lambda temp: _boxplots(rows, temp))
@@ -168,15 +167,6 @@ def _boxplots(rows: list[dict], path: str) -> None:
     figure.tight_layout()
     figure.savefig(path, format="png", dpi=100)
     plt.close(figure)
-
-
-def _csv(rows: list[dict], columns: list[str]) -> str:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        writer.writerow({k: "" if row.get(k) is None else row[k] for k in columns})
-    return buffer.getvalue()
 
 
 def _by_seed(rows: list[dict], key: str) -> dict[int, float | None]:

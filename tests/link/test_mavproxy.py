@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.links.mission_client import MissionClient, MissionTransferError
+from ground_station.links.mission_client import MissionTransferError
 from mission.link.waypoints import (
     WaypointRow,
     format_waypoints,
@@ -24,6 +24,7 @@ from mission.link.waypoints import (
 )
 from mission.world.frames import GeodeticFrame
 from tests.mav_client import MavClient
+from tests.mission_download import DownloadingClient, row_from_item
 from tests.processes import stop_process, vehicle_process
 
 pytestmark = pytest.mark.slow  # every test here starts processes
@@ -66,13 +67,13 @@ def test_mavproxy_loads_and_lists_a_waypoint_file(along, tmp_path):
     with vehicle_process("support-1", "--speedup", "1") as vehicle:
         loader, _ = _mavproxy(vehicle.port, f"wp load {path}", tmp_path)
         client = MavClient(vehicle.address)
-        mission = MissionClient(client.queue, vehicle.address, 2, timeout_s=0.5, retries=1)
+        mission = DownloadingClient(client.queue, vehicle.address, 2, timeout_s=0.5, retries=1)
         rows: list[WaypointRow] = []
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline and len(rows) != 4:
             time.sleep(0.5)
             try:
-                rows = [WaypointRow.from_item(item) for item in mission.download()]
+                rows = [row_from_item(item) for item in mission.download()]
             except MissionTransferError:
                 continue
         stop_process(loader)

@@ -10,7 +10,7 @@ import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
 from mission.link.mission_items import INT32_MAX, MissionItem
-from mission.link.waypoints import WaypointRow
+from tests.mission_download import row_from_item
 
 WAYPOINT = MissionItem(
     3, mavlink2.MAV_FRAME_GLOBAL_RELATIVE_ALT, mavlink2.MAV_CMD_NAV_WAYPOINT, 0, 1,
@@ -38,12 +38,12 @@ def test_every_form_carries_the_item_unchanged(item):
     # the float form holds x and y in float32: 35.6 degrees to ~4e-6 (40 in 1e-7 degrees)
     assert abs(from_float.x - item.x) <= 40 and abs(from_float.y - item.y) <= 80
     assert from_float == replace(item, x=from_float.x, y=from_float.y)
-    assert WaypointRow.from_item(item).to_item() == item
+    assert row_from_item(item).to_item() == item
 
 
 def test_x_and_y_are_degrees_only_in_a_global_frame():
     assert _wire(WAYPOINT.to_float_message((2, 1))).x == pytest.approx(35.6123456, abs=1e-5)
-    row = WaypointRow.from_item(SPEED)
+    row = row_from_item(SPEED)
     assert (row.x, row.y) == (5.0, 7.0)
     speed = _wire(SPEED.to_float_message((2, 1)))
     assert (speed.x, speed.y) == (5.0, 7.0)

@@ -12,8 +12,8 @@ import time
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.links.mission_client import MissionClient
 from tests.mav_client import MavClient
+from tests.mission_download import DownloadingClient
 from tests.processes import vehicle_process
 
 pytestmark = pytest.mark.slow  # a vehicle process
@@ -80,7 +80,7 @@ def test_qgroundcontrol_s_connect_sequence_completes(tmp_path):
                 assert refused == mavlink2.MAV_RESULT_UNSUPPORTED  # QGroundControl moves on
             parameters = _download_parameters(client)
             assert {p.param_id for p in parameters.values()} >= {"FS_GCS_TIMEOUT", "SIM_SPEEDUP"}
-            mission = MissionClient(client.queue, vehicle.address, SYSID, timeout_s=1.0)
+            mission = DownloadingClient(client.queue, vehicle.address, SYSID, timeout_s=1.0)
             assert mission.download() == []  # nothing uploaded yet: an empty mission
             for bit in ("MISSION_FENCE", "MISSION_RALLY"):  # so both downloads are skipped
                 assert not capabilities & getattr(mavlink2, f"MAV_PROTOCOL_CAPABILITY_{bit}")

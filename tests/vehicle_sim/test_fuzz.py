@@ -8,10 +8,10 @@ import time
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.links.mission_client import MissionClient
 from mission.link.mission_items import MissionItem
 from tests.fuzzing import hostile_datagrams
 from tests.mav_client import MavClient
+from tests.mission_download import DownloadingClient
 from tests.processes import vehicle_process
 
 pytestmark = pytest.mark.slow  # every test here starts processes
@@ -34,7 +34,7 @@ def test_vehicle_survives_fuzzing_and_still_takes_a_mission():
             MissionItem(i, 3, 16, 0, 1, 0.0, 0.1, 0.0, 0.0, 351500000 + i, 1369600000, 7.0)
             for i in range(6)
         ]
-        mission = MissionClient(client.queue, vehicle.address, 2, timeout_s=2.0)
+        mission = DownloadingClient(client.queue, vehicle.address, 2, timeout_s=2.0)
         assert mission.upload(items) == mavlink2.MAV_MISSION_ACCEPTED
         assert [i.x for i in mission.download()] == [i.x for i in items]
         client.close()

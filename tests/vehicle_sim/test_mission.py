@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
-from ground_station.links.mission_client import MissionClient
 from mission.link.mission_items import MISSION, MissionItem
 from mission.link.waypoints import (
     WaypointRow,
@@ -17,6 +16,7 @@ from mission.link.waypoints import (
 )
 from mission.world.frames import GeodeticFrame
 from tests.mav_client import MavClient
+from tests.mission_download import DownloadingClient, row_from_item
 from tests.processes import vehicle_process
 
 SYSID = 2  # support-1
@@ -48,11 +48,11 @@ def vehicle(scenario_file):
 
 def _rows(items: list[MissionItem]) -> list[WaypointRow]:
     """Compare missions as their file rows (float32 fields back to their decimals)."""
-    return [WaypointRow.from_item(item) for item in items]
+    return [row_from_item(item) for item in items]
 
 
-def _mission_client(client: MavClient) -> MissionClient:
-    return MissionClient(client.queue, client.vehicle, SYSID, timeout_s=1.0, retries=3)
+def _mission_client(client: MavClient) -> DownloadingClient:
+    return DownloadingClient(client.queue, client.vehicle, SYSID, timeout_s=1.0, retries=3)
 
 
 @pytest.mark.slow
@@ -62,7 +62,7 @@ def test_upload_download_round_trip_is_byte_identical(client, waypoint_file, tmp
     assert mission.upload(items) == mavlink2.MAV_MISSION_ACCEPTED
     downloaded = mission.download()
     saved = tmp_path / "downloaded.waypoints"
-    write_waypoints(saved, [WaypointRow.from_item(item) for item in downloaded])
+    write_waypoints(saved, [row_from_item(item) for item in downloaded])
     assert saved.read_bytes() == waypoint_file.read_bytes()
 
 
