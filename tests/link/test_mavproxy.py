@@ -128,3 +128,30 @@ def test_mavproxy_fetches_and_shows_the_parameters_after_its_ftp_attempt(tmp_pat
     assert any("parameter list (ftp)" in x for x in lines), "MAVProxy tried FTP first"
     shown = {x.split()[0]: x.split()[1] for x in lines if x.startswith(("SIM_", "WPNAV_"))}
     assert float(shown["WPNAV_SPEED"]) == 100.0 and float(shown["SIM_SPEEDUP"]) == 1.0, lines
+
+
+def test_mavproxy_sets_an_integer_parameter_it_has_not_fetched(tmp_path):
+    """``param forceload`` at start-up, before MAVProxy has the vehicle's list, sends
+    ``SIM_GPS1_ENABLE 0`` as REAL32 (pymavlink's mavset without a known type): the vehicle
+    takes it, as ArduPilot does, and keeps it as the integer it declares."""
+    (tmp_path / "gps-off.parm").write_text("SIM_GPS1_ENABLE 0\n")
+    with vehicle_process("support-1", "--speedup", "1") as vehicle:
+        setter, lines = _mavproxy(
+            vehicle.port, "param forceload gps-off.parm", tmp_path, modules="param"
+        )
+        reader = MavClient(vehicle.address)
+        try:
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline and _read(reader, "SIM_GPS1_ENABLE") != 0.0:
+                time.sleep(0.2)
+            name = b"SIM_GPS1_ENABLE"
+            reader.send(mavlink2.MAVLink_param_request_read_message(2, 1, name, -1))
+            echo = reader.wait_for(
+                "PARAM_VALUE", timeout_s=1.0, where=lambda m: m.param_id == name.decode()
+            )
+        finally:
+            reader.close()
+            stop_process(setter)
+    assert any("set SIM_GPS1_ENABLE to 0" in x for x in lines), lines  # sent unchecked
+    assert echo is not None and echo.param_value == 0.0, lines
+    assert echo.param_type != mavlink2.MAV_PARAM_TYPE_REAL32  # still its declared integer
