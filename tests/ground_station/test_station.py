@@ -125,7 +125,12 @@ def test_a_short_mission_completes_and_is_logged(short_scenario, tmp_path):
         "SYSTEM_TIME",
     ):
         assert counts.get(kind, 0) > 0, kind
-    assert len(setpoints) == 4 * summary["control_cycles"]  # one per vehicle and cycle
+    # one per vehicle and cycle, at the cycle's time (a setpoint at any other time is named)
+    cycle_ms = {round(r["t"] * 1000) for r in records}
+    for system in {target for target, _ in setpoints}:
+        sent = {ms for target, ms in setpoints if target == system}
+        assert sent == cycle_ms, (system, sorted(sent - cycle_ms), sorted(cycle_ms - sent))
+    assert len(setpoints) == 4 * summary["control_cycles"]
     # a record per cycle at the cycle's time, though the next tick goes out before it is written
     t_cont = load_scenario(str(short_scenario)).control.t_cont_s
     assert [r["t"] for r in records] == [
