@@ -71,6 +71,11 @@ class Structure:
         return self._solid_file_mesh
 
     @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) array: min and max corner of the structure."""
+        return np.array([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+
+    @property
     def uses_embree(self) -> bool:
         """True when ray queries go through Embree."""
         return self.rays.name == "Embree"

@@ -56,7 +56,7 @@ def test_two_rows_of_table3_are_made_again_as_committed(study, canary, tmp_path)
     runs_dir, _ = canary  # the canary is made once for both
     result = mission(
         "study",
-        f"studies/{study}.yaml",
+        study,  # a shipped study, by its name
         "--verify",
         "2",
         "--against",
