@@ -101,3 +101,11 @@ def pytest_runtest_teardown(item: pytest.Item):
     guard = item.stash.get(GUARD, None)
     if guard is not None:
         guard.undo()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _figures_closed():
+    """Tests that keep the figures they drew (to look into them) close them with their module."""
+    yield
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
