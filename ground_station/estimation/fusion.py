@@ -103,11 +103,6 @@ class LogDensity:
         return -0.5 * (np.sum(z * z, axis=0) + self.log_det + 3 * np.log(2 * np.pi))
 
 
-def log_gaussian(x: np.ndarray, mu: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-    """log N(x; mu, sigma) for rows of x."""
-    return LogDensity.of(mu, sigma)(x)
-
-
 def fuse(
     state: StationState,
     supports: list[SupportMeasurement],

@@ -13,7 +13,6 @@ from ground_station.estimation.fusion import (
     LogDensity,
     SupportMeasurement,
     correlation_matrix,
-    log_gaussian,
     selective_fusion,
     support_feedback,
 )
@@ -83,14 +82,14 @@ def test_a_1m_bias_is_excluded_and_the_estimate_stays_good(along_world, plan):
     assert error_biased < 0.7 * error_naive, "selection removes most of the bias"
 
 
-def test_log_gaussian_matches_scipy():
+def test_the_log_density_matches_scipy():
     rng = np.random.default_rng(1)
     a = rng.normal(size=(3, 3))
     sigma = a @ a.T + np.eye(3)
     mu = rng.normal(size=3)
     x = rng.normal(size=(5, 3))
     np.testing.assert_allclose(
-        log_gaussian(x, mu, sigma), multivariate_normal(mu, sigma).logpdf(x), rtol=1e-10
+        LogDensity.of(mu, sigma)(x), multivariate_normal(mu, sigma).logpdf(x), rtol=1e-10
     )
 
 
@@ -102,7 +101,7 @@ def test_correlation_matrix_matches_pearson_on_densities():
         (np.array([0.3, 0, 0]), 2 * np.eye(3)),
         (np.array([3.0, 0, 0]), 0.2 * np.eye(3)),
     ]
-    logs = [log_gaussian(x, mu, s) for mu, s in gaussians]
+    logs = [LogDensity.of(mu, s)(x) for mu, s in gaussians]
     rho = correlation_matrix(logs)
     for i in range(3):
         for j in range(3):
