@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from tests.processes import ROOT, mission
+from tests.shared_runs import SHORT
 
 pytestmark = pytest.mark.slow  # real runs and studies
 
@@ -75,18 +76,23 @@ def test_a_study_on_a_full_disk(small_disk):
     assert str(small_disk / "s") in line
 
 
-def test_a_plan_on_a_full_disk(small_disk):
+def _short(folder: Path) -> str:
+    """The short mission (three work waypoints: planned in a third of Along's time)."""
+    scenario = folder / "short-run.yaml"
+    scenario.write_text(SHORT)
+    return str(scenario)
+
+
+def test_a_plan_on_a_full_disk(small_disk, tmp_path):
     _fill(small_disk, 6_000)  # room for a waypoint file or two, not four
-    line = _refused(small_disk, "plan", "along", "--out", str(small_disk / "plan"))
+    line = _refused(small_disk, "plan", _short(tmp_path), "--out", str(small_disk / "plan"))
     assert str(small_disk / "plan") in line
 
 
 def test_a_plan_and_its_figure_or_neither(small_disk, tmp_path):
     _fill(small_disk, 4_000)  # the plan goes elsewhere, its figure onto the full disk
-    plan = tmp_path / "plan"
-    line = _refused(
-        small_disk, "plan", "along", "--out", str(plan), "--plot", str(small_disk / "p.png")
-    )
+    plan, figure = tmp_path / "plan", str(small_disk / "p.png")
+    line = _refused(small_disk, "plan", _short(tmp_path), "--out", str(plan), "--plot", figure)
     assert "p.png" in line
     assert not plan.exists(), "the plan was left without its figure"
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -49,35 +47,6 @@ def test_shipped_plan_satisfies_the_planner_constraints(along_world, shipped):
         points = shipped.supports[:, i]
         gaps = [np.linalg.norm(points[a] - points[b]) for a in range(3) for b in range(a + 1, 3)]
         assert min(gaps) >= scenario.planner.min_separation_m - ROUNDING_M
-
-
-@pytest.mark.slow
-def test_replanning_reproduces_the_shipped_files_byte_for_byte(tmp_path, along):
-    plot = tmp_path / "plan.png"
-    result = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "mission",
-            "plan",
-            "along",
-            "--out",
-            str(tmp_path),
-            "--plot",
-            str(plot),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert result.returncode == 0, result.stderr
-    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "an Along zone for this plan" in result.stdout
-    shipped_dir = Path(along.task.waypoints_dir)
-    for name in vehicle_names(3):
-        assert (tmp_path / f"{name}.waypoints").read_bytes() == (
-            shipped_dir / f"{name}.waypoints"
-        ).read_bytes(), name
 
 
 def test_shipped_files_round_trip_through_mavwp(along, tmp_path):

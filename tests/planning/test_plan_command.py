@@ -42,7 +42,9 @@ def test_the_package_is_refused_as_an_output(write_scenario):
         plan_directory(SHIPPED, scenario)
 
 
-def test_planning_leaves_the_shipped_plans_alone(monkeypatch, tmp_path, capsys):
+def test_replanning_gives_the_shipped_plans_byte_for_byte_and_leaves_them_alone(
+    monkeypatch, tmp_path, capsys
+):
     before = {p.name: p.read_bytes() for p in SHIPPED.iterdir()}
     monkeypatch.chdir(tmp_path)
     written = tmp_path / "along-plan"  # made by the command, and the figure may go into it
@@ -53,5 +55,6 @@ def test_planning_leaves_the_shipped_plans_alone(monkeypatch, tmp_path, capsys):
     assert plans == before  # the same plan
     out = capsys.readouterr().out
     assert f"waypoints_dir: {written}" in out and f"wrote {written / 'p.png'}" in out
+    assert "an Along zone for this plan" in out
     assert (written / "p.png").read_bytes()[:4] == b"\x89PNG"
     assert entry_point(["plan", "along", "--out", str(SHIPPED)]) == 2
