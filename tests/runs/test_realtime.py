@@ -24,19 +24,26 @@ pytestmark = pytest.mark.slow  # every test here starts processes
 LOCKSTEP_DECISIONS = "469a10ad51a85533"
 
 
-@pytest.mark.determinism
-def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
-    """In the paper's form (no margins, contacts flown through), as the digest was taken."""
-    scenario = tmp_path / "short-run.yaml"
+@pytest.fixture(scope="module")
+def paper_form_short(tmp_path_factory) -> Path:
+    """The short mission in the paper's form (no margins, contacts flown through), as the
+    digest was taken, in lockstep: its folder."""
+    tmp = tmp_path_factory.mktemp("short-paper-form")
+    scenario = tmp / "short-run.yaml"
     paper_form = "control: {min_separation_m: 0, clearance_m: 0}\n"
     scenario.write_text(
         SHORT.replace("run: {timeout_s: 120.0}", "run: {timeout_s: 120.0, stop_on_crash: false}")
         + paper_form
     )
     assert mission("plan", str(scenario)).returncode == 0
-    result = mission("run", str(scenario), "--out", str(tmp_path / "run"))
+    result = mission("run", str(scenario), "--out", str(tmp / "run"))
     assert result.returncode == 0, result.stderr
-    records = read_records(tmp_path / "run" / "records.jsonl")
+    return tmp / "run"
+
+
+@pytest.mark.determinism
+def test_lockstep_records_are_unchanged_and_carry_no_ages(paper_form_short):
+    records = read_records(paper_form_short / "records.jsonl")
     assert all("age_ms" not in record for record in records)
     digest = decisions_digest(records)
     assert digest == LOCKSTEP_DECISIONS, (
@@ -44,13 +51,19 @@ def test_lockstep_records_are_unchanged_and_carry_no_ages(tmp_path):
         f"{records[0]['xhat']}, the last at t = {records[-1]['t']}): a change in what the "
         f"paper's form decides; if it is meant, LOCKSTEP_DECISIONS = {digest!r}"
     )
-    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
-    # what the digest pins, in the run's own terms (they say what moved when the digest does)
+    summary = json.loads((paper_form_short / "summary.json").read_text())
+    assert summary["mode"] == "lockstep" and summary["speedup"] is None
+    assert summary["measurement_age_ms"] == {"median": 0.0, "p95": 0.0, "max": 0.0}
+
+
+@pytest.mark.determinism
+def test_what_the_lockstep_digest_pins(paper_form_short):
+    """The run the digest holds in its own terms: where a change moves the digest, this says
+    what moved (or that only a decision beyond these did)."""
+    summary = json.loads((paper_form_short / "summary.json").read_text())
     assert (summary["completion_time_s"], summary["control_cycles"]) == (28.0, 56)
     assert summary["multipath_steps"] == {"support-1": 0, "support-2": 56, "support-3": 0}
     assert summary["work_error_m"] == {"mean": 0.1725, "p95": 0.335, "max": 0.6409}
-    assert summary["mode"] == "lockstep" and summary["speedup"] is None
-    assert summary["measurement_age_ms"] == {"median": 0.0, "p95": 0.0, "max": 0.0}
 
 
 def _independent_pairing(tlog: Path, epoch: float, frame) -> tuple[dict, list, list, np.ndarray]:

@@ -31,7 +31,7 @@ run: {{stop_on_crash: {stop}}}
 # Along AC seed 0 in the paper's form: its cycles and the digest of its decisions
 # (mission.analysis.decisions: every record but its wall-clock fields, numbers to 1e-6), the
 # same whatever SIMD numpy and OpenBLAS use. A change that means to alter the paper's form
-# says so by updating it. The digest holds every decision of the run at once; the test also
+# says so by updating it. The digest holds every decision of the run at once; a second test
 # states the run's outcome in its own terms, which say what moved when the digest does.
 PAPER_FORM_DECISIONS = (509, "d20f4eb6c1d54842")
 
@@ -42,26 +42,40 @@ def _paper_form(tmp_path: Path, stop: bool) -> Path:
     return path
 
 
-@pytest.mark.determinism
-def test_the_papers_form_is_one_setting_away(tmp_path):
-    result = mission("run", str(_paper_form(tmp_path, False)), "--out", str(tmp_path / "run"))
+@pytest.fixture(scope="module")
+def paper_form_run(tmp_path_factory) -> Path:
+    """Along AC seed 0 in the paper's form, flown through its contacts: its folder."""
+    tmp = tmp_path_factory.mktemp("paper-form")
+    result = mission("run", str(_paper_form(tmp, False)), "--out", str(tmp / "run"))
     assert result.returncode == 0, result.stderr
-    records = read_records(tmp_path / "run" / "records.jsonl")
+    return tmp / "run"
+
+
+@pytest.mark.determinism
+def test_the_papers_form_is_one_setting_away(paper_form_run):
+    records = read_records(paper_form_run / "records.jsonl")
     assert (len(records), decisions_digest(records)) == PAPER_FORM_DECISIONS
-    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    summary = json.loads((paper_form_run / "summary.json").read_text())
     assert summary["decisions_digest"] == PAPER_FORM_DECISIONS[1]
-    # what the digest pins, in the terms a reader of the run sees: where a change moved the
-    # digest, these say first what moved
-    assert (summary["completion_time_s"], summary["multipath_steps"]) == (
-        254.5,
-        {"support-1": 13, "support-2": 1, "support-3": 0},
-    )
-    assert summary["work_error_m"] == {"mean": 0.1408, "p95": 0.2686, "max": 0.6355}
     safety = summary["safety"]
     # without margins support-1 flies into the deck's edge and on: recorded, not stopped
     assert safety["contacts"] and not any(c["crash"] for c in safety["contacts"])
     assert "support-1" in safety["touching_vehicles"]
     assert {c["vehicle"] for c in safety["contacts"]} >= {"support-1"}
+
+
+@pytest.mark.determinism
+def test_what_the_papers_form_digest_pins(paper_form_run):
+    """The run the digest holds, in the terms a reader of it sees: where a change moves the
+    digest, this says what moved (or that only a decision beyond these did)."""
+    summary = json.loads((paper_form_run / "summary.json").read_text())
+    assert (summary["completion_time_s"], summary["multipath_steps"]) == (
+        254.5,
+        {"support-1": 13, "support-2": 1, "support-3": 0},
+    )
+    assert summary["work_error_m"] == {"mean": 0.1408, "p95": 0.2686, "max": 0.6355}
+    first = summary["safety"]["contacts"][0]
+    assert (first["vehicle"], first["with"], first["t"]) == ("support-1", "structure", 22.5)
 
 
 @pytest.fixture(scope="module")
