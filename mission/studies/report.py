@@ -43,7 +43,7 @@ INTEGRITY_METRICS = (
     ("integrity.missed_detections", "lying faults missed"),
     ("integrity.time_to_detect_s", "time to detect [s]"),
     ("integrity.false_alarms", "false exclusions"),
-    ("integrity.zone_exclusions", "exclusions in a zone"),
+    ("integrity.zone_exclusions", "exclusions of a biased fix"),
     ("integrity.protection.work.integrity_events", "work UAV integrity events"),
     ("integrity.protection.supports.integrity_events", "supports' integrity events"),
 )
