@@ -13,12 +13,13 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from ground_station.links.mission_client import MissionClient, MissionTransferError
 from mission.link.mission_items import (
     COMMON_FIELDS,
-    FLOAT32_FIELDS,
     MISSION,
     MissionItem,
     from_int_field,
 )
 from mission.link.waypoints import WaypointRow
+
+FLOAT32_FIELDS = ("param1", "param2", "param3", "param4", "z")  # float on the wire
 
 
 class DownloadingClient(MissionClient):

@@ -113,20 +113,3 @@ def _tested_sigma(support: SupportMeasurement) -> np.ndarray:
     gnss, relative = support.sigma_gnss_tested_m2, support.sigma_relative_m2
     assert gnss is not None and relative is not None
     return gnss + relative
-
-
-def formation_estimate(
-    others: Sequence[SupportMeasurement],
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """The work UAV's position from the given supports, information-weighted, and its
-    covariance (None with none contributing)."""
-    formation = Formation(others)
-    return formation.estimate(list(formation.members))
-
-
-def formation_innovation(
-    support: SupportMeasurement, others: Sequence[SupportMeasurement]
-) -> Innovation | None:
-    """The formation test's innovation (None where the support or no other contributes)."""
-    formation = Formation([support, *(m for m in others if m.name != support.name)])
-    return formation.innovation(support.name, list(formation.members))

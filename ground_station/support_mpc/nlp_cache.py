@@ -1,6 +1,6 @@
 """The support MPC's NLPs compiled to shared libraries with the system C compiler, and cached
 (:mod:`mission.codegen.casadi_cache`): a plan takes about a quarter of the time it takes with
-casadi's interpreter. The first run generates and compiles (both NLPs at once, one compiler
+casadi's interpreter. The first run generates and compiles (every NLP at once, one compiler
 process each); later runs load the cached libraries and build nothing.
 """
 
@@ -15,11 +15,9 @@ from mission.codegen import casadi_cache
 from mission.codegen.casadi_cache import FunctionBuild, NlpBuild, c_compiler
 from mission.codegen.news import Compiling
 
-__all__ = ["COMPILED", "COMPILING", "FunctionBuild", "NlpBuild", "c_compiler"]
+__all__ = ["FunctionBuild", "NlpBuild", "c_compiler"]
 
 SUPPORT_MPC = Compiling("ground station", "the support MPC", "support_mpc")
-COMPILING = SUPPORT_MPC.starting  # what `mission run` shows of a first run's wait
-COMPILED = SUPPORT_MPC.done
 
 
 @contextmanager

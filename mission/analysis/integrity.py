@@ -144,18 +144,25 @@ def _unfaulted(
     exclusions: list[tuple[float, dict[str, Any]]],
     faults: dict[str, list[list[float]]],
 ) -> tuple[int, int]:
-    """(false alarms, zone exclusions) among the exclusions with no lying fault on the
-    support: those with no zone bias at its true position, and those with one."""
+    """(false alarms, exclusions of a biased fix) among the exclusions with no lying fault on
+    the support: those whose fix no multipath biased (no zone at its true position and, with
+    multipath from geometry, a true error within the detectable bias), and the others."""
     false_alarms = in_zones = 0
     geometry = world.scenario.world.gnss.multipath != "zones"
     threshold = detectable_bias_m(world) if geometry else np.inf
+    period_s = 1.0 / world.scenario.vehicle.sensor_hz
+    listed: dict[int, list[float]] = defaultdict(list)
+    for system, t in sorted(trace.fixes):
+        listed[system].append(t)
+    fix_times = {system: np.array(times) for system, times in listed.items()}
     for t, event in exclusions:
         name = event["support"]
         if any(start <= t <= end for start, end in faults.get(name, [])):
             continue
         system = VehicleIdentity.parse(name).system_id
         truth, known = trace.truth_at(system, [t])
-        fix = trace.fixes.get((system, t))
+        times = fix_times.get(system, np.empty(0))
+        fix = _fix_at(trace, times, system, t, period_s) if geometry else None
         biased = bool(known[0]) and (
             _near_a_zone(world, truth[0])
             or (fix is not None and float(np.linalg.norm(fix - truth[0])) > threshold)
@@ -200,6 +207,18 @@ def _true_error(trace: RunTrace, name: str, t: float) -> float | None:
         return None
     truth, known = trace.truth_at(system, [t])
     return float(np.linalg.norm(estimate - truth[0])) if known[0] else None
+
+
+def _fix_at(
+    trace: RunTrace, times: np.ndarray, system: int, t: float, period_s: float
+) -> np.ndarray | None:
+    """The vehicle's latest 3-D fix at or before ``t`` (``times``: its fixes' times, sorted),
+    if within one sensor period of it (in real time a fix's time is its receiver's, not the
+    cycle's)."""
+    index = int(np.searchsorted(times, t + 1e-9, side="right")) - 1
+    if index < 0 or times[index] < t - period_s - 1e-9:
+        return None
+    return trace.fixes[(system, float(times[index]))]
 
 
 def _near_a_zone(world: World, position: np.ndarray) -> bool:

@@ -6,6 +6,7 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
+from mission.procs.command_line import FLOWN
 from mission.procs.commands import mission_run_argv
 from mission.procs.process_life import child_environment
 
@@ -18,5 +19,7 @@ def run_as_command(
     import json
 
     command = mission_run_argv(scenario, out, method, 0, mpc_helper, ["--exit-with-parent"])
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=child_environment())
+    flown = subprocess.run(command, stdout=subprocess.DEVNULL, env=child_environment())
+    if flown.returncode not in FLOWN:  # a run that timed out is a result: a missed target
+        raise subprocess.CalledProcessError(flown.returncode, command)
     return json.loads((out / "summary.json").read_text())

@@ -10,6 +10,7 @@ import tempfile
 from pathlib import Path
 
 from mission.bench.result import BenchResult
+from mission.procs.command_line import FLOWN
 from mission.procs.commands import mission_run_argv
 from mission.procs.process_life import child_environment
 
@@ -40,7 +41,9 @@ def _wall(out: Path, view: bool) -> float:
     is over and it says so."""
     command = mission_run_argv("along", out, extra=["--exit-with-parent"])  # a killed bench
     if not view:
-        subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=child_environment())
+        flown = subprocess.run(command, stdout=subprocess.DEVNULL, env=child_environment())
+        if flown.returncode not in FLOWN:  # a run that timed out still took its wall time
+            raise subprocess.CalledProcessError(flown.returncode, command)
         return json.loads((out / "summary.json").read_text())["wall_time_s"]
     process = subprocess.Popen(
         [*command, "--view", "web"], stdout=subprocess.PIPE, text=True, env=child_environment()

@@ -113,7 +113,12 @@ def compiled_builds(
         made = _generate_and_compile(compiler, builds, missing, fallback_dir, who.prefix)
         for index, library in made.items():
             libraries[index] = library
-        who.finished(parts, time.monotonic() - started)
+        failed = [builds[index].part for index in missing if index not in made]
+        done = [builds[index].part for index in missing if index in made]
+        if done:
+            who.finished(done, time.monotonic() - started)
+        if failed:  # interpreted instead: the same results, slower
+            who.failed(failed, Path(compiler).name)
     return libraries
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 STARTED = re.compile(r"^compiling (?P<what>.+?) with (?P<compiler>\S+): ")
 DONE = re.compile(r"^compiled (?P<what>.+?) in (?P<s>\d+(?:\.\d+)?) s$")
+FAILED = re.compile(r"^could not compile (?P<what>.+?) with \S+: ")
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,13 @@ class Compiling:
     def finished(self, parts: list[str], seconds: float) -> None:
         """Say that ``parts`` took ``seconds`` to compile."""
         self._say(f"{self.done} ({', '.join(parts)}) in {seconds:.1f} s")
+
+    def failed(self, parts: list[str], compiler: str) -> None:
+        """Say that ``parts`` could not be compiled (they are interpreted instead)."""
+        self._say(
+            f"could not compile {self.what} ({', '.join(parts)}) with {compiler}: "
+            "interpreting it instead (the same results, slower)"
+        )
 
     def _say(self, text: str) -> None:
         print(f"{self.who}: {text}", file=sys.stderr, flush=True)

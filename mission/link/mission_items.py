@@ -45,7 +45,6 @@ COMMON_FIELDS = (
     ("param4", float),
     ("z", float),
 )
-FLOAT32_FIELDS = ("param1", "param2", "param3", "param4", "z")  # float on the wire
 
 
 def position_scale(frame: int) -> float:

@@ -12,6 +12,7 @@ from mission.procs.disk_full import EXIT_NO_SPACE, no_space_error, no_space_line
 
 EXIT_BAD_INPUT = 2
 EXIT_NOT_COMPLETED = 4  # a run flown to its end whose work task did not complete
+FLOWN = (0, EXIT_NOT_COMPLETED)  # ``mission run``'s statuses for a run flown to its end
 
 
 class DefaultsHelpFormatter(argparse.HelpFormatter):

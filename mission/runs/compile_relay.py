@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from mission.codegen.news import DONE, STARTED, compilations
+from mission.codegen.news import DONE, FAILED, STARTED, compilations
 from mission.procs.file_tail import FileTail
 
 
@@ -31,7 +31,7 @@ class CompileRelay:
             text = line.decode("utf-8", "replace").split(": ", 1)[-1]
             if STARTED.match(text):
                 self.open += 1
-            elif DONE.match(text):
+            elif DONE.match(text) or FAILED.match(text):
                 self.open = max(0, self.open - 1)
             else:
                 continue

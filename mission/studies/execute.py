@@ -18,14 +18,13 @@ import yaml
 
 from mission.config.scenario import resolved_mapping
 from mission.procs.atomic import write_text_atomically
-from mission.procs.command_line import EXIT_NOT_COMPLETED
+from mission.procs.command_line import FLOWN
 from mission.procs.commands import mission_run_argv
 from mission.procs.process_life import child_environment
 from mission.studies.runkeys import StudyRun
 
 Keep = Literal["all", "logs", "summary"]
 KEEP_CHOICES: tuple[Keep, ...] = get_args(Keep)
-FLOWN = (0, EXIT_NOT_COMPLETED)  # ``mission run``'s statuses for a run flown to its end
 SCENARIO_FILE = "scenario.yaml"
 
 

@@ -27,7 +27,7 @@ class StructureProximity:
     def __init__(self, structure: Structure) -> None:
         self.low, self.high = structure.box_low, structure.box_high
         self._file_mesh = structure.file_mesh
-        self._parts = [] if self._file_mesh is None else mesh_parts(self._file_mesh)
+        self._parts = structure.file_parts
 
     @property
     def has_file_mesh(self) -> bool:
@@ -101,15 +101,6 @@ class StructureProximity:
         """Distance from each point to whatever is nearer, the structure or the ground."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         return np.minimum(self.distance(points), points[:, 2])
-
-
-def mesh_parts(mesh) -> list[tuple[object, bool]]:
-    """The connected parts of a mesh (triangles sharing a vertex, once coincident vertices are
-    merged), each with whether it is watertight (it has an inside)."""
-    merged = mesh.copy()
-    merged.merge_vertices()
-    parts = merged.split(only_watertight=False)
-    return [(part, bool(part.is_watertight)) for part in parts]
 
 
 def segment_points(start: np.ndarray, end: np.ndarray, spacing_m: float) -> np.ndarray:

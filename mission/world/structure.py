@@ -32,17 +32,15 @@ class Structure:
         vertices: np.ndarray,
         faces: np.ndarray,
         boxes: list[BoxPrimitive],
-        solid_file_mesh: trimesh.Trimesh | None = None,
     ) -> None:
         """``vertices`` (n, 3) and ``faces`` (m, 3) are everything that occludes; ``boxes`` and
-        a watertight ``solid_file_mesh`` answer inside/outside queries."""
+        the watertight connected parts of the mesh file answer inside/outside queries."""
         self.vertices = np.asarray(vertices, dtype=float).reshape(-1, 3)
         self.faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
         self.rays = best_ray_engine(self.vertices, self.faces)
         self.boxes = boxes
         self.box_low = np.array([b.min_m for b in boxes], dtype=float).reshape(-1, 3)
         self.box_high = np.array([b.max_m for b in boxes], dtype=float).reshape(-1, 3)
-        self._solid_file_mesh = solid_file_mesh
 
     @cached_property
     def mesh(self) -> trimesh.Trimesh:
@@ -65,10 +63,17 @@ class Structure:
         remap[used] = np.arange(len(used))
         return trimesh.Trimesh(self.vertices[used], remap[extra], process=False)
 
-    @property
-    def solid_file_mesh(self) -> trimesh.Trimesh | None:
-        """The mesh file's mesh where it is watertight (it has an inside), else None."""
-        return self._solid_file_mesh
+    @cached_property
+    def file_parts(self) -> list[tuple[trimesh.Trimesh, bool]]:
+        """The mesh file's connected parts (triangles sharing a vertex, once coincident
+        vertices are merged), each with whether it is watertight (it has an inside): the
+        pieces contact, the margins and inside/outside queries see."""
+        mesh = self.file_mesh
+        if mesh is None:
+            return []
+        merged = mesh.copy()
+        merged.merge_vertices()
+        return [(part, bool(part.is_watertight)) for part in merged.split(only_watertight=False)]
 
     @property
     def bounds(self) -> np.ndarray:
@@ -108,7 +113,8 @@ class Structure:
         return blocked
 
     def contains(self, points: np.ndarray) -> np.ndarray:
-        """True for points inside a solid of the structure (boxes, or a watertight mesh file)."""
+        """True for points inside a solid of the structure (a box, or a watertight part of the
+        mesh file)."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         inside = np.zeros(len(points), dtype=bool)
         if len(self.box_low):
@@ -120,24 +126,22 @@ class Structure:
                 ),
                 axis=1,
             )
-        if self._solid_file_mesh is not None:
-            inside |= self._solid_file_mesh.contains(points)
+        for part, solid in self.file_parts:
+            if solid:
+                inside |= part.contains(points)
         return inside
 
 
 def build_structure(settings: StructureSettings, source: str = "") -> Structure:
     """Build the structure's mesh from its primitives and mesh file."""
     parts = [_box_triangles(box) for box in settings.primitives]
-    solid_file_mesh = None
     if settings.mesh_file is not None:
         file_mesh = load_mesh_file(Path(settings.mesh_file), source)
         parts.append((np.asarray(file_mesh.vertices), np.asarray(file_mesh.faces)))
-        if file_mesh.is_watertight:
-            solid_file_mesh = file_mesh
     offsets = np.cumsum([0] + [len(vertices) for vertices, _ in parts[:-1]])
     vertices = np.vstack([vertices for vertices, _ in parts])
     faces = np.vstack([faces + offset for (_, faces), offset in zip(parts, offsets)])
-    return Structure(vertices, faces, list(settings.primitives), solid_file_mesh)
+    return Structure(vertices, faces, list(settings.primitives))
 
 
 def load_mesh_file(path: Path, source: str = "") -> trimesh.Trimesh:

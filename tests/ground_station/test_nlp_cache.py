@@ -52,11 +52,11 @@ def test_a_compilation_says_so_and_how_long_it_took_and_a_hit_says_nothing(
     nlp, options = _tiny_solver()
     _compiled_one("tiny", "ipopt", nlp, options, lambda: str(tmp_path))
     said = capsys.readouterr().err.splitlines()
-    compiler = Path(c_compiler()).name
-    assert said[0] == f"ground station: {nlp_cache.COMPILING} (tiny) with {compiler}: " + (
+    compiler, news = Path(c_compiler()).name, nlp_cache.SUPPORT_MPC
+    assert said[0] == f"ground station: {news.starting} (tiny) with {compiler}: " + (
         f"once per machine, cached in {tmp_path / 'cache' / 'bridge-uav-formation'}"
     )
-    assert said[1].startswith(f"ground station: {nlp_cache.COMPILED} (tiny) in ") and len(said) == 2
+    assert said[1].startswith(f"ground station: {news.done} (tiny) in ") and len(said) == 2
     _compiled_one("tiny", "ipopt", nlp, options, lambda: str(tmp_path))
     assert capsys.readouterr().err == ""
 
@@ -200,22 +200,30 @@ with nlp_cache.compiled_libraries([nlp_cache.NlpBuild("tiny", "ipopt", nlp, IPOP
 def test_processes_wanting_the_same_library_at_once_compile_it_once(tmp_path):
     """A ground station and its helper (or four vehicles) start together on a fresh machine:
     one compiles, the others wait for it and load what it cached."""
+    import fcntl
     import os
     import subprocess
     import sys
 
     require_c_compiler()
     env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
-    processes = [
-        subprocess.Popen(
-            [sys.executable, "-c", TINY_COMPILE],
-            env=env,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        for _ in range(3)
-    ]
+    cache = tmp_path / "cache" / "bridge-uav-formation"
+    cache.mkdir(parents=True)
+    with (cache / ".support_mpc.lock").open("a") as held:  # the turn is taken: all three wait
+        fcntl.flock(held, fcntl.LOCK_EX)
+        processes = [
+            subprocess.Popen(
+                [sys.executable, "-c", TINY_COMPILE],
+                env=env,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for _ in range(3)
+        ]
+        waiting = _waiting_on_locks({process.pid for process in processes}, timeout_s=60.0)
+        assert waiting == {process.pid for process in processes}, "each waits for its turn"
+        assert not list(cache.glob("*.so"))
     outputs = [process.communicate(timeout=120) for process in processes]
     assert all(process.returncode == 0 for process in processes), outputs
     libraries = {out.strip() for out, _ in outputs}
@@ -225,3 +233,39 @@ def test_processes_wanting_the_same_library_at_once_compile_it_once(tmp_path):
         "ground station: compiling the support MPC (tiny)"
     ]
     assert len([line for line in said if "compiled the support MPC (tiny) in" in line]) == 1
+
+
+def test_a_failed_compilation_says_so_and_the_nlp_is_interpreted(tmp_path, monkeypatch, capsys):
+    from mission.codegen import casadi_cache
+    from mission.runs.compile_relay import CompileRelay, compile_summary
+
+    require_c_compiler()
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.setattr(casadi_cache, "COMPILE_FLAGS", ["--no-such-flag", "-shared"])
+    nlp, options = _tiny_solver()
+    assert _compiled_one("tiny", "ipopt", nlp, options, lambda: str(tmp_path)) is None
+    said = capsys.readouterr().err
+    assert "could not compile the support MPC (tiny) with" in said
+    assert "compiled the support MPC" not in said  # nothing said done that was not
+    log = tmp_path / "ground_station.log"
+    log.write_text(said)
+    relay = CompileRelay(log)
+    relay.poll()
+    assert not relay.compiling and compile_summary(log) == {}  # no compile to leave out
+
+
+def _waiting_on_locks(pids: set[int], timeout_s: float) -> set[int]:
+    """Which of ``pids`` wait on a file lock (Linux's /proc/locks lists a blocked request
+    as ``-> FLOCK ...``), once all do or the time is up."""
+    import time
+
+    deadline = time.monotonic() + timeout_s
+    while True:
+        blocked = set()
+        for line in Path("/proc/locks").read_text().splitlines():
+            fields = line.split()
+            if "->" in fields and "FLOCK" in fields:
+                blocked.add(int(fields[fields.index("->") + 4]))
+        if pids <= blocked or time.monotonic() > deadline:
+            return blocked & pids
+        time.sleep(0.1)

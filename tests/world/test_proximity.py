@@ -5,6 +5,7 @@ straight motions against a dense sampling."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import trimesh
 
 from mission.world.proximity import StructureProximity, closest_approach, segment_points
@@ -92,3 +93,31 @@ def _by_distance(distance, closest, normals):
     order = np.argsort(distance, axis=1)
     rows = np.arange(len(distance))[:, None]
     return distance[rows, order], closest[rows, order], normals[rows, order]
+
+
+def test_a_watertight_part_is_solid_to_every_query_though_the_file_is_open(tmp_path):
+    """A box beside an open plate: the file is not watertight, the box is; inside it both the
+    structure's containment and the distances say so."""
+    from mission.config.scenario import load_scenario
+    from mission.world.model import World
+
+    box = trimesh.creation.box(bounds=[(-2.0, -2.0, 0.0), (2.0, 2.0, 4.0)])
+    plate = trimesh.Trimesh([[5, 0, 1], [9, 0, 1], [9, 4, 1]], [[0, 1, 2]])
+    path = tmp_path / "mixed.stl"
+    trimesh.util.concatenate([box, plate]).export(path)
+    world = World(
+        load_scenario(
+            "along",
+            {
+                "world.structure.mesh_file": str(path),
+                "world.structure.primitives": [],
+                "world.zones": [],
+            },
+        )
+    )
+    proximity = StructureProximity(world.structure)
+    inside, outside = np.array([[0.0, 0.0, 2.0]]), np.array([[7.0, 1.0, 3.0]])
+    assert world.structure.contains(inside)[0] and not world.structure.contains(outside)[0]
+    assert proximity.distance(inside)[0] == pytest.approx(-2.0)
+    assert proximity.distance(outside)[0] == pytest.approx(2.0)
+    assert world.placement_problem(inside[0]) == "inside the structure"
