@@ -106,10 +106,16 @@ class AutopilotSettings:
     loops a factor ~2.5-4 apart (PX4's MPC_XY_P 0.95, MPC_XY_VEL_P_ACC 1.8, MC_ROLL_P 6.5)."""
 
     position_gain_per_s: float
-    velocity_gain_per_s: float
+    velocity_gain_per_s: float  # MPC_XY_VEL_P_ACC
+    velocity_integral_gain_per_s2: float  # MPC_XY_VEL_I_ACC
+    vertical_velocity_gain_per_s: float  # MPC_Z_VEL_P_ACC
+    vertical_integral_gain_per_s2: float  # MPC_Z_VEL_I_ACC
     attitude_gain_per_s: float
     rate_gain_per_s: float
-    acceleration_max_m_s2: float
+    thrust_min: float  # MPC_THR_MIN, of the rotors' total
+    thrust_xy_margin: float  # MPC_THR_XY_MARG: horizontal thrust the vertical always leaves
+    climb_max_m_s: float  # MPC_Z_VEL_MAX_UP
+    descent_max_m_s: float  # MPC_Z_VEL_MAX_DN
     tilt_max_deg: float
     rate_max_rad_s: float
     # between two VISION_POSITION_ESTIMATEs the belief moves by the filter's velocity, the true
@@ -120,9 +126,12 @@ class AutopilotSettings:
     def __post_init__(self) -> None:
         _non_negative(self, "velocity_bias_m_s", "velocity_noise_m_s")
         _positive(self, "position_gain_per_s", "velocity_gain_per_s", "attitude_gain_per_s")
-        _positive(
-            self, "rate_gain_per_s", "acceleration_max_m_s2", "tilt_max_deg", "rate_max_rad_s"
-        )
+        _positive(self, "rate_gain_per_s", "tilt_max_deg", "rate_max_rad_s")
+        _positive(self, "vertical_velocity_gain_per_s", "climb_max_m_s", "descent_max_m_s")
+        _non_negative(self, "velocity_integral_gain_per_s2", "vertical_integral_gain_per_s2")
+        _non_negative(self, "thrust_min", "thrust_xy_margin")
+        _at_most(self, 0.5, "a share of the rotors' thrust", "thrust_min")
+        _at_most(self, 0.9, "a share of the rotors' thrust", "thrust_xy_margin")
         _require(
             MIN_TILT_DEG <= self.tilt_max_deg < 90,
             "tilt_max_deg",

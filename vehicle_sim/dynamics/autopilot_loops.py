@@ -30,6 +30,7 @@ from mission.config.multicopter_settings import (
     AutopilotSettings,
     MulticopterSettings,
 )
+from vehicle_sim.dynamics.px4_thrust import thrust_setpoint
 from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     POSITION,
@@ -72,22 +73,21 @@ def motor_commands(
     mass, g = body.mass_kg, STANDARD_GRAVITY
     believed = state[POSITION] + belief_offset
     velocity, q, rates = state[VELOCITY], state[ATTITUDE], state[RATES]
-    wanted_velocity = _capped(loops.position_gain_per_s * (target - believed), speed_limit)
-    error = wanted_velocity - velocity
-    acceleration = (
-        loops.velocity_gain_per_s * error
-        + integral
-        + body.drag_n_per_m_s / mass * wanted_velocity  # the drag the setpoint will meet
+    wanted = loops.position_gain_per_s * (target - believed)
+    # PX4: the horizontal speed capped by norm, the vertical by the climb and descent limits
+    horizontal_velocity = _capped(wanted[:2], speed_limit)
+    vertical_velocity = ca.fmin(ca.fmax(wanted[2], -loops.descent_max_m_s), loops.climb_max_m_s)
+    error = ca.vertcat(horizontal_velocity, vertical_velocity) - velocity
+    hover = mass * g / (4 * body.rotor_thrust_max_n)
+    gains = (
+        loops.velocity_gain_per_s,
+        loops.vertical_velocity_gain_per_s,
+        loops.velocity_integral_gain_per_s2,
+        loops.vertical_integral_gain_per_s2,
     )
-    # the integral (gain Kv^2 / 4: the velocity loop critically damped) grows only while the
-    # acceleration is not at its limit (conditional integration, PX4's anti-windup)
-    room = ca.norm_2(acceleration) < loops.acceleration_max_m_s2
-    integral_rate = ca.if_else(room, loops.velocity_gain_per_s**2 / 4 * error, ca.DM.zeros(3))
-    acceleration = _capped(acceleration, loops.acceleration_max_m_s2)
-    force = mass * (acceleration + ca.vertcat(0, 0, g))
-    vertical = ca.fmax(force[2], 0.1 * mass * g)
-    horizontal = _capped(force[:2], vertical * math.tan(math.radians(loops.tilt_max_deg)))
-    force = ca.vertcat(horizontal, vertical)
+    limits = (math.radians(loops.tilt_max_deg), loops.thrust_min, 1.0, loops.thrust_xy_margin)
+    thrust, integral_rate = thrust_setpoint(error, integral, hover, gains, limits)
+    force = thrust * 4 * body.rotor_thrust_max_n
     z_axis = force / ca.norm_2(force)
     y_axis = ca.cross(z_axis, ca.DM([1.0, 0.0, 0.0]))
     y_axis = y_axis / ca.norm_2(y_axis)
