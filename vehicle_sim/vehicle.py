@@ -16,6 +16,7 @@ import numpy as np
 from numpy.random import default_rng as rng
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.config.autopilot_settings import PX4_PARAMETERS
 from mission.config.settings import Scenario
 from mission.config.wind_settings import WindSettings
 from mission.link.mavlink_udp import LinkCounters
@@ -123,6 +124,8 @@ class Vehicle:
             self.speed_limit_m_s = value / 100.0
         elif name == "SIM_LINK_LOSS" and self.on_link_loss is not None:
             self.on_link_loss(value)
+        elif name in PX4_PARAMETERS and hasattr(self.kinematics, "tune"):  # a multicopter's
+            self.kinematics.tune(PX4_PARAMETERS[name], value)
         what = parameter_change(name, value)
         self.notify(mavlink2.MAV_SEVERITY_INFO, event_text(source, what, self.sim_time_s))
 

@@ -4,15 +4,18 @@ every vehicle dying at its first step.
 
 - The integration step h = 1 / ``rate_hz`` (at most :data:`MAX_RATE_HZ`: a step of substeps
   is computed whole) is at most half of the body's fastest time constants: the motors' lag,
-  mass over drag, the least moment of inertia over the rotational damping (a classical
+  mass over the rotors' drag at full thrust, the least moment of inertia over the rotational
+  damping (a classical
   Runge-Kutta step is stable to |lambda h| ~ 2.8; two steps a time constant keeps it accurate).
 - The rate loop, a gain K on the rate error through the motors' first-order lag tau, is the
   second-order loop s^2 tau + s + K: its natural frequency sqrt(K / tau) at most
   :data:`MAX_LOOP_FREQUENCY_STEPS` / h (it runs once a substep, its command held) and its
   damping 1 / (2 sqrt(K tau)) at least :data:`MIN_RATE_LOOP_DAMPING`.
 - The cascade runs each loop at least :data:`MIN_CASCADE_RATIO` times slower than the one
-  inside it: position, velocity, attitude, rate (closer, the loops couple: 15/30/60/99 per s
-  passes every check above and crashes).
+  inside it: velocity, attitude, rate (closer, the loops couple: 30/60/99 per s passes every
+  check above and crashes); the position loop at least :data:`MIN_POSITION_RATIO` times
+  slower than the velocity loop (PX4's defaults, 0.95 and 1.8: its velocity loop's integral
+  and derivative let the two sit closer).
 """
 
 from __future__ import annotations
@@ -20,19 +23,17 @@ from __future__ import annotations
 import itertools
 import math
 
+from mission.config.autopilot_settings import AutopilotSettings
 from mission.config.checks import require
-from mission.config.multicopter_settings import (
-    STANDARD_GRAVITY,
-    AutopilotSettings,
-    MulticopterSettings,
-)
+from mission.config.multicopter_settings import STANDARD_GRAVITY, MulticopterSettings
 
 MAX_RATE_HZ = 2000.0
 STEPS_PER_TIME_CONSTANT = 2.0
 MAX_LOOP_FREQUENCY_STEPS = 0.5  # the rate loop's natural frequency times h
 MIN_RATE_LOOP_DAMPING = 0.2
 MAX_THRUST_TO_WEIGHT = 10.0
-MIN_CASCADE_RATIO = 2.5  # the defaults: 2.5, 3.2, 3.1 (a rule of thumb is 3-5)
+MIN_CASCADE_RATIO = 2.5  # the defaults: 4.4, 3.1 (a rule of thumb is 3-5)
+MIN_POSITION_RATIO = 1.5  # the defaults: 1.9 (PX4's)
 
 
 def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
@@ -44,8 +45,12 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
     )
     h = 1.0 / body.rate_hz
     constants = [("motor_tau_s", "the motors' lag", body.motor_tau_s)]
-    if body.drag_n_per_m_s > 0:
-        constants.append(("mass_kg", "mass over drag", body.mass_kg / body.drag_n_per_m_s))
+    full_speed = math.sqrt(body.rotor_thrust_max_n / body.rotor_thrust_coefficient)
+    drag = 4 * full_speed * body.rotor_drag_coefficient
+    if drag > 0:
+        constants.append(
+            ("rotor_drag_coefficient", "mass over the rotors' drag", body.mass_kg / drag)
+        )
     if body.rotational_damping_n_m_per_rad_s > 0:
         least = min(body.inertia_kg_m2) / body.rotational_damping_n_m_per_rad_s
         constants.append(("inertia_kg_m2", "inertia over rotational damping", least))
@@ -80,18 +85,19 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
         f"({hover:.2f} N; a racing quadrotor's thrust-to-weight)",
     )
     require(
-        body.rotor_torque_max_n_m <= body.rotor_thrust_max_n * body.arm_m,
+        body.rotor_torque_max_n_m <= body.rotor_thrust_max_n * body.lever_m,
         "multicopter.rotor_torque_max_n_m",
-        "must be at most rotor_thrust_max_n x arm_m (a propeller's drag torque is a few per "
+        "must be at most rotor_thrust_max_n x lever_m (a propeller's drag torque is a few per "
         "cent of its thrust's moment)",
     )
     cascade = ("position", "velocity", "attitude", "rate")
     for outer, inner in itertools.pairwise(cascade):
+        least = MIN_POSITION_RATIO if outer == "position" else MIN_CASCADE_RATIO
         slow = getattr(loops, f"{outer}_gain_per_s")
         fast = getattr(loops, f"{inner}_gain_per_s")
         require(
-            MIN_CASCADE_RATIO * slow <= fast,
+            least * slow <= fast,
             f"autopilot.{outer}_gain_per_s",
             f"{slow:g} must be below {inner}_gain_per_s ({fast:g}) by a factor of at least "
-            f"{MIN_CASCADE_RATIO:g}: a loop too close to the one it commands couples with it",
+            f"{least:g}: a loop too close to the one it commands couples with it",
         )

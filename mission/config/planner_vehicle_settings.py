@@ -5,13 +5,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from mission.config.autopilot_settings import AutopilotSettings
 from mission.config.checks import as_parameter as _as_parameter
 from mission.config.checks import at_most as _at_most
 from mission.config.checks import non_negative as _non_negative
 from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
 from mission.config.flight_checks import check_flyable
-from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
+from mission.config.multicopter_settings import MulticopterSettings
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,7 @@ class PlannerSettings:
         _require(self.rounds >= 1, "rounds", "must be at least 1")
 
 
+KINEMATIC_RADIUS_M = 0.25  # a kinematic vehicle's sphere (frame and propellers)
 MIN_HEARTBEAT_HZ = 0.2
 MAX_STREAM_HZ = 100.0
 
@@ -51,7 +53,8 @@ class VehicleSettings:
     """
 
     tracking_noise_m: float
-    radius_m: float
+    radius_m: float | None  # None: the default for the dynamics (:func:`body_radius`); a
+    # number once built
     failsafe_s: float
     heartbeat_hz: float
     status_hz: float
@@ -66,6 +69,8 @@ class VehicleSettings:
     autopilot: AutopilotSettings
 
     def __post_init__(self) -> None:
+        if self.radius_m is None:  # frozen: set once, as the scenario leaves it to the default
+            object.__setattr__(self, "radius_m", body_radius(self))
         _non_negative(self, "tracking_noise_m")
         _positive(self, "radius_m")
         _positive(self, "failsafe_s", "heartbeat_hz", "status_hz", "sensor_hz")
@@ -94,3 +99,11 @@ class VehicleSettings:
         _require(self.mission_capacity >= 1, "mission_capacity", "must be at least 1")
         if self.dynamics == "multicopter":
             check_flyable(self.multicopter, self.autopilot)
+
+
+def body_radius(vehicle: VehicleSettings) -> float:
+    """The bounding radius a scenario leaves to the default: a multicopter's rotor tips, a
+    kinematic vehicle's :data:`KINEMATIC_RADIUS_M`."""
+    if vehicle.dynamics == "multicopter":
+        return vehicle.multicopter.rotor_tips_m
+    return KINEMATIC_RADIUS_M

@@ -2,11 +2,13 @@
 during a run.
 
 Ids follow ArduPilot where it has the same setting (``WPNAV_SPEED``, ``FS_GCS_TIMEOUT``,
-``SR0_*``, ``SIM_GPS1_*``, ``SIM_WIND_SPD``, ``SIM_WIND_DIR``), our own ``SIM_*`` where it has
-none (ArduPilot's ``SIM_WIND_TURB`` is an amplitude in m/s; ours, ``SIM_WIND_DRYDEN``, scales
-MIL-F-8785C's intensities). The vehicle builds its table
-from this catalogue and the scenario (``vehicle_sim.mavlink.parameters``); a scenario's ``faults:``
-are checked against it before any process starts. docs/vehicle.md lists every entry.
+``SR0_*``, ``SIM_GPS1_*``, ``SIM_WIND_SPD``, ``SIM_WIND_DIR``), PX4 for a multicopter's
+position controller (``MPC_*``, as PX4's ``mc_pos_control`` names them; the ranges are the
+ones our loops accept), our own ``SIM_*`` where neither has one (ArduPilot's
+``SIM_WIND_TURB`` is an amplitude in m/s; ours, ``SIM_WIND_DRYDEN``, scales MIL-F-8785C's
+intensities). The vehicle builds its table from this catalogue and the scenario
+(``vehicle_sim.mavlink.parameters``); a scenario's ``faults:`` are checked against it before
+any process starts. docs/vehicle.md lists every entry.
 """
 
 from __future__ import annotations
@@ -87,6 +89,20 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     _live("SIM_LINK_LOSS", False, 0, 0.9, "chance a datagram sent is lost (--link-loss)"),
     _fixed("SIM_RADIUS", False, "the body's radius for contact, m (vehicle.radius_m)"),
     _live("SIM_FAIL_ENABLE", True, 0, 1, "1 allows MAV_CMD_INJECT_FAILURE (PX4's SYS_FAILURE_EN)"),
+    # a multicopter's position controller, under PX4's names (vehicle.autopilot.*)
+    _live("MPC_XY_P", False, 0.1, 2, "horizontal position gain, 1/s (multicopters)"),
+    _live("MPC_Z_P", False, 0.1, 1.5, "vertical position gain, 1/s (multicopters)"),
+    _live("MPC_XY_VEL_P_ACC", False, 1.2, 5, "horizontal velocity P, 1/s (multicopters)"),
+    _live("MPC_XY_VEL_I_ACC", False, 0, 3, "horizontal velocity I, 1/s2 (multicopters)"),
+    _live("MPC_XY_VEL_D_ACC", False, 0, 2, "horizontal velocity D (multicopters)"),
+    _live("MPC_Z_VEL_P_ACC", False, 2, 15, "vertical velocity P, 1/s (multicopters)"),
+    _live("MPC_Z_VEL_I_ACC", False, 0.2, 3, "vertical velocity I, 1/s2 (multicopters)"),
+    _live("MPC_XY_VEL_MAX", False, 0.5, 20, "horizontal speed limit, m/s (multicopters)"),
+    _live("MPC_Z_VEL_MAX_UP", False, 0.5, 8, "climb speed limit, m/s (multicopters)"),
+    _live("MPC_Z_VEL_MAX_DN", False, 0.5, 4, "descent speed limit, m/s (multicopters)"),
+    _live("MPC_TILTMAX_AIR", False, 20, 89, "tilt limit, degrees (multicopters)"),
+    _live("MPC_THR_MIN", False, 0.05, 0.5, "least collective thrust, of the most (multicopters)"),
+    _live("MPC_THR_XY_MARG", False, 0, 0.5, "horizontal thrust margin, of the most (multicopters)"),
 )
 _BY_NAME = {spec.name: spec for spec in PARAMETERS}
 

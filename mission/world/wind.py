@@ -224,6 +224,10 @@ class VehicleWind:
         gusts = DrydenGusts(settings, height_m, dt_s, rng)
         return cls(WindField(settings, boxes), gusts, boxes, height_m)
 
+    def mean_at(self, position: np.ndarray) -> np.ndarray:
+        """The mean wind at ``position`` (ENU, m/s): no gusts, no draw."""
+        return self.field.factor(position) * self.field.free_stream
+
     def over_step(self, position: np.ndarray, count: int) -> np.ndarray:
         """(count, 3): the wind at ``position`` over the next ``count`` substeps (still air:
         zeros, and no draw)."""

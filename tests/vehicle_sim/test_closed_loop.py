@@ -13,15 +13,15 @@ import pytest
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
 from mission.config.scenario import load_scenario
+from vehicle_sim.dynamics.autopilot_loops import CONTROLLER_SIZE
 from vehicle_sim.dynamics.closed_loop import ClosedLoop
 from vehicle_sim.dynamics.rigid_body import ATTITUDE, POSITION, THRUSTS, VELOCITY, resting_state
 
 BODY, LOOPS = load_scenario("along").vehicle.multicopter, load_scenario("along").vehicle.autopilot
 TICK_S = 0.02  # steps this short, to watch the response
 CALM, NO_OFFSET = np.zeros(3), np.zeros(3)
-# What the defaults do with a 1 m step (docs/model.md): no overshoot, within 2 cm in 5 s.
-SETTLE_S, SETTLE_BAND_M, OVERSHOOT_M = 5.0, 0.02, 0.01
-SPEED_OVERSHOOT = 0.05  # at most 5 % over the speed limit when a long move starts
+# What PX4's default gains do with a 1 m step (docs/model.md): 8.7 cm over, within 2 cm in 4.74 s
+SETTLE_S, SETTLE_BAND_M, OVERSHOOT_M = 5.0, 0.02, 0.09
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +30,7 @@ def loop() -> ClosedLoop:
 
 
 def _start(position) -> np.ndarray:
-    return np.concatenate([resting_state(position, BODY), np.zeros(3)])
+    return np.concatenate([resting_state(position, BODY), np.zeros(CONTROLLER_SIZE)])
 
 
 def _fly(loop, state, target, seconds, speed=3.0, wind=CALM, offset=NO_OFFSET):
@@ -52,10 +52,10 @@ def test_hovering_the_rotors_carry_the_weight(loop):
     assert np.abs(state[POSITION] - [0.0, 0.0, 10.0]).max() < 1e-6
 
 
-def test_a_position_step_settles_in_the_documented_time_without_overshoot(loop):
+def test_a_position_step_settles_in_the_documented_time_and_overshoot(loop):
     _, track = _fly(loop, _start([0.0, 0.0, 10.0]), [1.0, 0.0, 10.0], 8.0)
     x = track[:, 0]
-    assert x.max() - 1.0 <= OVERSHOOT_M
+    assert 0.8 * OVERSHOOT_M < x.max() - 1.0 <= OVERSHOOT_M
     outside = np.flatnonzero(np.abs(x - 1.0) > SETTLE_BAND_M)
     assert (outside[-1] + 1) * TICK_S <= SETTLE_S
     assert (outside[-1] + 1) * TICK_S > 0.6 * SETTLE_S  # the documented time is not loose
@@ -64,16 +64,16 @@ def test_a_position_step_settles_in_the_documented_time_without_overshoot(loop):
 
 def test_a_long_move_keeps_the_speed_and_tilt_limits(loop):
     _, track = _fly(loop, _start([0.0, 0.0, 10.0]), [20.0, 0.0, 12.0], 12.0, speed=3.0)
-    speeds = np.linalg.norm(track[:, VELOCITY], axis=1)
-    # the velocity loop overshoots its setpoint a little as the move starts (docs/model.md)
-    assert 2.9 < speeds.max() <= 3.0 * (1 + SPEED_OVERSHOOT)
+    horizontal = np.linalg.norm(track[:, VELOCITY][:, :2], axis=1)
+    assert 2.9 < horizontal.max() <= 3.0  # the guidance's limit, below MPC_XY_VEL_MAX
+    assert np.abs(track[:, VELOCITY][:, 2]).max() <= LOOPS.climb_max_m_s
     tilts = [_tilt_deg(q) for q in track[:, ATTITUDE]]
     assert max(tilts) <= LOOPS.tilt_max_deg + 1.0
 
 
 def test_a_steady_wind_is_held_off_by_the_integral(loop):
     wind = np.array([3.0, -1.0, 0.0])
-    state, track = _fly(loop, _start([0.0, 0.0, 10.0]), [0.0, 0.0, 10.0], 20.0, wind=wind)
+    state, track = _fly(loop, _start([0.0, 0.0, 10.0]), [0.0, 0.0, 10.0], 30.0, wind=wind)
     assert np.abs(track[:, POSITION] - [0.0, 0.0, 10.0]).max() < 0.5  # pushed, then back
     assert np.abs(state[POSITION] - [0.0, 0.0, 10.0]).max() < 0.01
 
@@ -95,7 +95,7 @@ def test_the_same_flight_twice_is_the_same_bit_for_bit(loop):
 
 
 def test_a_tilt_limit_of_90_degrees_or_more_is_refused():
-    with pytest.raises(FieldProblem, match=r"\[5, 90\) degrees"):
+    with pytest.raises(FieldProblem, match=r"\[20, 89\] degrees"):
         replace(LOOPS, tilt_max_deg=90.0)
 
 
@@ -107,4 +107,4 @@ def test_compiled_and_interpreted_fly_the_same_bit_for_bit(loop):
         a, path_a = loop.advance(a, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
         b, path_b = interpreted.advance(b, target, NO_OFFSET, 3.0, np.array([1.0, 0.5, 0.0]))
     assert np.array_equal(a, b) and not np.array_equal(a, start)
-    assert np.array_equal(path_a, path_b) and np.array_equal(path_a[-1], a[:3])
+    assert np.array_equal(path_a, path_b) and np.array_equal(path_a[-1, :3], a[:3])

@@ -18,11 +18,12 @@ TILT = math.radians(45.0)
 LIMITS = (TILT, 0.12, 1.0, 0.3)  # MPC_TILTMAX_AIR, MPC_THR_MIN, MPC_THR_MAX, MPC_THR_XY_MARG
 
 
-def _evaluate(error, integral=(0.0, 0.0, 0.0)):
-    e, i = ca.SX.sym("e", 3), ca.SX.sym("i", 3)
-    thrust, rate = thrust_setpoint(e, i, HOVER, GAINS, LIMITS)
-    function = ca.Function("f", [e, i], [thrust, rate])
-    thrust, rate = function(np.array(error, float), np.array(integral, float))
+def _evaluate(error, integral=(0.0, 0.0, 0.0), damping=(0.0, 0.0, 0.0)):
+    e, i, d = ca.SX.sym("e", 3), ca.SX.sym("i", 3), ca.SX.sym("d", 3)
+    thrust, rate = thrust_setpoint(e, i, d, HOVER, GAINS, LIMITS)
+    function = ca.Function("f", [e, i, d], [thrust, rate])
+    arrays = (np.array(v, float) for v in (error, integral, damping))
+    thrust, rate = function(*arrays)
     return np.array(thrust).ravel(), np.array(rate).ravel()
 
 
@@ -52,10 +53,16 @@ def test_the_vertical_keeps_all_but_the_margin_and_the_horizontal_gets_the_rest(
     assert np.linalg.norm(thrust) == pytest.approx(1.0)  # the rest to the horizontal
     assert rate[2] == 0.0  # at the maximum, asking for more up: not integrated
     a_wanted = 1.8 * 20.0
-    produced = thrust[0] * G / HOVER
+    produced = thrust[0] * G / thrust[2]  # the tilt it makes: g tan(tilt)
     assert rate[0] == pytest.approx(0.4 * (20.0 - 2.0 / 1.8 * (a_wanted - produced)))
 
 
 def test_a_descent_below_the_minimum_thrust_stops_integrating_down():
     thrust, rate = _evaluate([0.0, 0.0, -10.0])
     assert thrust[2] == pytest.approx(0.12) and rate[2] == 0.0
+
+
+def test_the_derivative_term_takes_its_acceleration_off_the_setpoint():
+    # PX4: a_sp = Kp e + integral - Kd dv/dt; a 0.1 m/s error against a 0.2 m/s2 damping term
+    thrust, _ = _evaluate([0.1, 0.0, 0.0], damping=[0.2, 0.0, 0.0])
+    assert thrust[0] == pytest.approx(HOVER * (1.8 * 0.1 - 0.2) / G, rel=1e-6)

@@ -1,21 +1,23 @@
 """The autopilot's position controller for the rigid body (docs/model.md, "A multicopter's
-dynamics"), as casadi expressions run at the integration rate: the cascade ArduPilot's and
-PX4's multicopter controllers use.
+dynamics"), as casadi expressions run at the integration rate: PX4's multicopter cascade.
 
-1. position error (from where the autopilot *believes* it is) -> velocity setpoint, capped
-   at the speed limit;
-2. velocity error -> acceleration setpoint, proportional and integral (the integral holds
-   against steady wind; it grows only while the acceleration is below its limit), plus the
-   drag the setpoint velocity will meet, then capped;
-3. the thrust vector m (a + g z) with its tilt capped, and the attitude that points the body's
-   z along it at a fixed heading (the formation's UAVs do not yaw);
-4. attitude error (the geometric one of Lee, Leok and McClamroch 2010) -> body-rate
-   setpoint, capped;
-5. rate error -> moments (with the gyroscopic term), and the collective thrust along the
-   current body z; the mixer turns thrust and moments into the four rotors' thrusts.
+1. position error (from where the autopilot *believes* it is) -> velocity setpoint: PX4's
+   MPC_XY_P and MPC_Z_P, the horizontal speed capped by norm at the lower of the guidance's
+   limit and MPC_XY_VEL_MAX, the vertical at MPC_Z_VEL_MAX_UP / _DN;
+2. velocity error -> acceleration -> thrust vector: PX4's PID with its tilt and thrust limits
+   and anti-windup (:mod:`~vehicle_sim.dynamics.px4_thrust`); the derivative acts on the
+   velocity's rate of change, low-passed at MPC_VELD_LP (a filter state);
+3. the attitude that points the body's z along the thrust at a fixed heading (the formation's
+   UAVs do not yaw), its error (the geometric one of Lee, Leok and McClamroch 2010) -> body
+   rates, capped;
+4. rate error -> moments (with the gyroscopic term), and the collective thrust along the
+   current body z; the mixer (:mod:`~vehicle_sim.dynamics.mixer`) turns thrust and moments
+   into the four rotors' commands, desaturated as PX4's.
 
-The controller's state is the velocity error's integral (3 values), carried after the rigid
-body's 17.
+The tunable values (:data:`~mission.config.autopilot_settings.TUNED_FIELDS`) come in as one
+input vector, so a parameter set in flight takes effect without a new compilation. The
+controller's state is the velocity error's integral (3) and the low-passed velocity (3),
+carried after the rigid body's 17.
 """
 
 from __future__ import annotations
@@ -25,34 +27,14 @@ import math
 import casadi as ca
 import numpy as np
 
-from mission.config.multicopter_settings import (
-    STANDARD_GRAVITY,
-    AutopilotSettings,
-    MulticopterSettings,
-)
+from mission.config.autopilot_settings import TUNED_FIELDS, AutopilotSettings
+from mission.config.multicopter_settings import STANDARD_GRAVITY, MulticopterSettings
+from vehicle_sim.dynamics.mixer import motor_commands_mixed
 from vehicle_sim.dynamics.px4_thrust import thrust_setpoint
-from vehicle_sim.dynamics.rigid_body import (
-    ATTITUDE,
-    POSITION,
-    RATES,
-    ROTOR_ANGLES_DEG,
-    ROTOR_SPINS,
-    VELOCITY,
-    rotation,
-)
+from vehicle_sim.dynamics.rigid_body import ATTITUDE, POSITION, RATES, VELOCITY, rotation
 
 TINY = 1e-9
-
-
-def mixer(body: MulticopterSettings) -> np.ndarray:
-    """(4, 4): the rotors' thrusts from [collective thrust, roll, pitch and yaw moments]."""
-    per_thrust = body.rotor_torque_max_n_m / body.rotor_thrust_max_n
-    columns = []
-    for angle, spin in zip(ROTOR_ANGLES_DEG, ROTOR_SPINS):
-        x = body.arm_m * math.cos(math.radians(angle))
-        y = body.arm_m * math.sin(math.radians(angle))
-        columns.append([1.0, y, -x, -spin * per_thrust])
-    return np.linalg.inv(np.array(columns).T)
+CONTROLLER_SIZE = 6  # the integral (3), the low-passed velocity (3)
 
 
 def _capped(vector: ca.SX, limit) -> ca.SX:
@@ -60,33 +42,56 @@ def _capped(vector: ca.SX, limit) -> ca.SX:
     return vector * ca.fmin(1, limit / (ca.norm_2(vector) + TINY))
 
 
+def _tuned(tuning: ca.SX) -> dict[str, ca.SX]:
+    return {name: tuning[i] for i, name in enumerate(TUNED_FIELDS)}
+
+
+def velocity_setpoint(
+    tune: dict[str, ca.SX], believed: ca.SX, target: ca.SX, speed_limit: ca.SX
+) -> ca.SX:
+    """PX4's position loop: the velocity wanted, each direction within its limits."""
+    error = target - believed
+    horizontal = _capped(
+        tune["position_gain_per_s"] * error[:2],
+        ca.fmin(speed_limit, tune["horizontal_speed_max_m_s"]),
+    )
+    vertical = tune["vertical_position_gain_per_s"] * error[2]
+    vertical = ca.fmin(ca.fmax(vertical, -tune["descent_max_m_s"]), tune["climb_max_m_s"])
+    return ca.vertcat(horizontal, vertical)
+
+
 def motor_commands(
     body: MulticopterSettings,
     loops: AutopilotSettings,
     state: ca.SX,
-    integral: ca.SX,
-    target: ca.SX,
-    belief_offset: ca.SX,
-    speed_limit: ca.SX,
+    controller: ca.SX,
+    inputs: tuple[ca.SX, ca.SX, ca.SX, ca.SX],
 ) -> tuple[ca.SX, ca.SX]:
-    """(the rotors' commands 0..1, d(integral)/dt) for this state and position target."""
-    mass, g = body.mass_kg, STANDARD_GRAVITY
-    believed = state[POSITION] + belief_offset
+    """(the rotors' commands, d(controller state)/dt) for this state; ``inputs`` are the
+    position target, the belief's offset from the truth, the guidance's speed limit and the
+    tuning vector."""
+    target, belief_offset, speed_limit, tuning = inputs
+    tune = _tuned(tuning)
     velocity, q, rates = state[VELOCITY], state[ATTITUDE], state[RATES]
-    wanted = loops.position_gain_per_s * (target - believed)
-    # PX4: the horizontal speed capped by norm, the vertical by the climb and descent limits
-    horizontal_velocity = _capped(wanted[:2], speed_limit)
-    vertical_velocity = ca.fmin(ca.fmax(wanted[2], -loops.descent_max_m_s), loops.climb_max_m_s)
-    error = ca.vertcat(horizontal_velocity, vertical_velocity) - velocity
-    hover = mass * g / (4 * body.rotor_thrust_max_n)
-    gains = (
-        loops.velocity_gain_per_s,
-        loops.vertical_velocity_gain_per_s,
-        loops.velocity_integral_gain_per_s2,
-        loops.vertical_integral_gain_per_s2,
+    integral, smoothed = controller[:3], controller[3:]
+    wanted = velocity_setpoint(tune, state[POSITION] + belief_offset, target, speed_limit)
+    cutoff = 2 * math.pi * loops.velocity_derivative_cutoff_hz
+    acceleration = cutoff * (velocity - smoothed)  # d/dt of the velocity, low-passed
+    damping = tune["velocity_derivative_gain"] * ca.vertcat(acceleration[:2], 0)
+    hover = body.mass_kg * STANDARD_GRAVITY / (4 * body.rotor_thrust_max_n)
+    gains = tuple(
+        tune[name]
+        for name in (
+            "velocity_gain_per_s",
+            "vertical_velocity_gain_per_s",
+            "velocity_integral_gain_per_s2",
+            "vertical_integral_gain_per_s2",
+        )
     )
-    limits = (math.radians(loops.tilt_max_deg), loops.thrust_min, 1.0, loops.thrust_xy_margin)
-    thrust, integral_rate = thrust_setpoint(error, integral, hover, gains, limits)
+    limits = (tune["tilt_max_deg"], tune["thrust_min"], 1.0, tune["thrust_xy_margin"])
+    thrust, integral_rate = thrust_setpoint(
+        wanted - velocity, integral, damping, hover, gains, limits
+    )
     force = thrust * 4 * body.rotor_thrust_max_n
     z_axis = force / ca.norm_2(force)
     y_axis = ca.cross(z_axis, ca.DM([1.0, 0.0, 0.0]))
@@ -101,5 +106,5 @@ def motor_commands(
     moment = inertia @ (loops.rate_gain_per_s * (wanted_rates - rates))
     moment += ca.cross(rates, inertia @ rates)
     collective = ca.dot(force, current[:, 2])
-    thrusts = ca.DM(mixer(body)) @ ca.vertcat(collective, moment)
-    return thrusts / body.rotor_thrust_max_n, integral_rate
+    commands = motor_commands_mixed(body, ca.vertcat(collective, moment))
+    return commands, ca.vertcat(integral_rate, acceleration)

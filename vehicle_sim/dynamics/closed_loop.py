@@ -6,8 +6,9 @@ Runge-Kutta step) and the controller's integral by Euler, as a flight controller
 at a fixed rate. One casadi Function does a whole step, compiled with the system C
 compiler and cached as the support MPC is; the same inputs give the same state bit for bit.
 
-State (20): the body's 17, then the controller's velocity-error integral (3). A step also
-gives the body's position after every few substeps: the path contact detection follows.
+State (23): the body's 17, then the controller's (6: the velocity error's integral and the
+low-passed velocity). A step also gives the body's position and attitude after every few
+substeps: the path contact detection follows.
 """
 
 from __future__ import annotations
@@ -17,10 +18,13 @@ import numpy as np
 
 from mission.codegen.casadi_cache import compiled_function
 from mission.codegen.news import Compiling
-from mission.config.multicopter_settings import AutopilotSettings, MulticopterSettings
-from vehicle_sim.dynamics.autopilot_loops import motor_commands
+from mission.config.autopilot_settings import TUNED_FIELDS, AutopilotSettings
+from mission.config.multicopter_settings import MulticopterSettings
+from vehicle_sim.dynamics.autopilot_loops import CONTROLLER_SIZE, motor_commands
 from vehicle_sim.dynamics.rigid_body import (
+    ATTITUDE,
     OPEN_AIR,
+    POSITION,
     STATE_SIZE,
     SURFACES_SIZE,
     runge_kutta_substep,
@@ -28,8 +32,11 @@ from vehicle_sim.dynamics.rigid_body import (
 )
 
 DYNAMICS = Compiling("vehicle", "its flight dynamics", "vehicle_flight")
-FLIGHT_STATE_SIZE = STATE_SIZE + 3
-INTEGRAL = slice(STATE_SIZE, FLIGHT_STATE_SIZE)
+FLIGHT_STATE_SIZE = STATE_SIZE + CONTROLLER_SIZE
+CONTROLLER = slice(STATE_SIZE, FLIGHT_STATE_SIZE)
+INTEGRAL = slice(STATE_SIZE, STATE_SIZE + 3)
+SMOOTHED_VELOCITY = slice(STATE_SIZE + 3, FLIGHT_STATE_SIZE)
+TUNING_SIZE = len(TUNED_FIELDS)
 PATH_INTERVAL_S = 0.02  # the path's points at most this far apart in time (3 cm at 1.5 m/s)
 
 
@@ -42,7 +49,7 @@ def path_stride(substeps: int, h: float) -> int:
 
 class ClosedLoop:
     """One step of the flown body: :meth:`advance` (state, target, belief offset, speed limit,
-    wind, surfaces) -> the state a step later and the positions on the way."""
+    wind, surfaces, tuning) -> the state a step later and the poses on the way."""
 
     def __init__(
         self,
@@ -54,27 +61,32 @@ class ClosedLoop:
         """``compiled``: with the system C compiler (cached once per machine and settings),
         else casadi's interpreter (the same states, slower)."""
         self.body, self.loops, self.step_s = body, loops, step_s
+        self.tuning = np.array(loops.tuning())
         self.substeps = substeps_of(step_s, body.rate_hz)
         h = step_s / self.substeps
         flight = ca.SX.sym("x", FLIGHT_STATE_SIZE)
         target, offset, wind = ca.SX.sym("t", 3), ca.SX.sym("d", 3), ca.SX.sym("w", 3)
         speed, surfaces = ca.SX.sym("s"), ca.SX.sym("h", SURFACES_SIZE)
-        state, integral = flight[:STATE_SIZE], flight[INTEGRAL]
-        command, integral_rate = motor_commands(body, loops, state, integral, target, offset, speed)
+        tuning = ca.SX.sym("k", TUNING_SIZE)
+        state, controller = flight[:STATE_SIZE], flight[CONTROLLER]
+        command, controller_rate = motor_commands(
+            body, loops, state, controller, (target, offset, speed, tuning)
+        )
         after = runge_kutta_substep(body, state, command, wind, surfaces, h)
-        after = ca.vertcat(after, integral + h * integral_rate)
-        inputs = [flight, target, offset, speed, surfaces, wind]
+        after = ca.vertcat(after, controller + h * controller_rate)
+        inputs = [flight, target, offset, speed, tuning, surfaces, wind]
         substep = ca.Function("flight", inputs, [after])
         # the state after every few substeps (at most PATH_INTERVAL_S apart): the path
         stride = path_stride(self.substeps, h)
         stretch = substep.fold(stride) if stride > 1 else substep
         stretches = stretch.mapaccum(self.substeps // stride)
-        held = [ca.MX.sym(name, size) for name, size in (("t", 3), ("d", 3), ("s", 1))]
-        held.append(ca.MX.sym("h", SURFACES_SIZE))
+        sizes = (("t", 3), ("d", 3), ("s", 1), ("k", TUNING_SIZE), ("h", SURFACES_SIZE))
+        held = [ca.MX.sym(name, size) for name, size in sizes]
         gusty = ca.MX.sym("w", 3, self.substeps)  # the wind at each substep
         start = ca.MX.sym("x", FLIGHT_STATE_SIZE)
         states = stretches(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
-        final, path = states[:, -1], states[:3, :]
+        final = states[:, -1]
+        path = ca.vertcat(states[POSITION, :], states[ATTITUDE, :])
         step = ca.Function("flight_step", [start, *held, gusty], [final, path])
         self._step = compiled_function(step, DYNAMICS, compiled)
 
@@ -86,12 +98,16 @@ class ClosedLoop:
         speed_limit_m_s: float,
         wind: np.ndarray,
         surfaces: np.ndarray = OPEN_AIR,
+        tuning: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(the state a step later, (n, 3) the position after every few substeps, the last one
-        the step's end: :func:`path_stride`); ``wind`` (3,) held over the step, or
-        (substeps, 3) one vector a substep; ``surfaces`` the heights above, then below, each
-        rotor (:data:`~vehicle_sim.dynamics.rigid_body.OPEN_AIR`: none near)."""
+        """(the state a step later, (n, 7) the position and attitude after every few
+        substeps, the last one the step's end: :func:`path_stride`); ``wind`` (3,) held over
+        the step, or (substeps, 3) one vector a substep; ``surfaces`` the heights above, then
+        below, each rotor (:data:`~vehicle_sim.dynamics.rigid_body.OPEN_AIR`: none near);
+        ``tuning`` the loops' tunable values (None: the settings')."""
         wind = np.asarray(wind, dtype=float)
         winds = np.repeat(wind.reshape(3, 1), self.substeps, axis=1) if wind.ndim == 1 else wind.T
-        final, path = self._step(state, target, belief_offset, speed_limit_m_s, surfaces, winds)
+        tuning = self.tuning if tuning is None else tuning
+        held = (target, belief_offset, speed_limit_m_s, tuning, surfaces)
+        final, path = self._step(state, *held, winds)
         return np.asarray(final, dtype=float).reshape(FLIGHT_STATE_SIZE), np.asarray(path).T

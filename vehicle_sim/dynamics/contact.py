@@ -1,12 +1,16 @@
-"""Contact detection: a vehicle's true body (a sphere of ``vehicle.radius_m``) touching the
-structure, the ground or another vehicle's body.
+"""Contact detection: a vehicle's true body touching the structure, the ground or another
+vehicle's body.
 
-Each step's motion is a path: a point's straight segment, or a flying body's positions at its
-substeps joined by straight legs. Against the structure and the ground it is sampled
-every quarter radius (a body cannot pass through a deck between samples); against another
-vehicle the two straight motions over the same interval give their exact closest approach
-(:func:`~mission.world.proximity.closest_approach`). A contact is a distance below the radius
-(below two radii between bodies): a near miss just outside is none.
+Each step's motion is a path: a point's straight segment, or a flying body's poses at its
+substeps joined by straight legs. Against the structure and the ground the body is a sphere of
+``vehicle.radius_m`` (a kinematic vehicle), or a flying quadrotor's rotor rims and frame at
+its attitude (:mod:`~vehicle_sim.dynamics.contact_body`); the path is sampled every quarter
+radius, or every :data:`BODY_SPACING_M` for a quadrotor's points (a body cannot pass through a
+deck between samples). Against another vehicle the two straight motions of the centres over
+the same interval give their exact closest approach
+(:func:`~mission.world.proximity.closest_approach`), bounding spheres of ``vehicle.radius_m``.
+A contact is a distance below the radius (below two radii between bodies): a near miss just
+outside is none.
 """
 
 from __future__ import annotations
@@ -17,17 +21,20 @@ import numpy as np
 
 from mission.world.frames import enu_to_ned, ned_to_enu
 from mission.world.proximity import StructureProximity, closest_approach, segment_points
+from vehicle_sim.dynamics.contact_body import ContactBody
 
 CLEAR_SLACK_M = 1e-6  # rounding's share in the shortcut of a path clear of everything
 STRUCTURE = "structure"
 GROUND = "ground"
+BODY_SPACING_M = 0.05  # a quadrotor's path sampled this often against the structure
 
 
 @dataclass(frozen=True)
 class Contact:
     """What a vehicle touched (``structure``, ``ground`` or another vehicle's name), when
     (simulated seconds), where (its own true position then, ENU) and the distance found
-    (centre to surface; centre to centre between vehicles)."""
+    (centre to surface; a quadrotor's point to the surface less the point's tolerance; centre
+    to centre between vehicles)."""
 
     other: str
     time_s: float
@@ -65,37 +72,53 @@ def dense_path(
 class ContactDetector:
     """One vehicle's contact checks, with its radius and the structure's proximity."""
 
-    def __init__(self, proximity: StructureProximity, radius_m: float) -> None:
+    def __init__(
+        self, proximity: StructureProximity, radius_m: float, body: ContactBody | None = None
+    ) -> None:
+        """``body``: a quadrotor's points against the structure and the ground (None: the
+        sphere of ``radius_m``)."""
         self.proximity = proximity
         self.radius_m = radius_m
+        self.body = body
 
     def along(self, path: np.ndarray, start_s: float, end_s: float) -> list[Contact]:
         """The first contact with the structure and the first with the ground along ``path``
-        ((n, 3) positions at equal times from ``start_s`` to ``end_s``: a flying body's
-        substeps, or a point's two ends)."""
+        ((n, 3) positions or (n, 7) poses at equal times from ``start_s`` to ``end_s``: a
+        flying body's substeps, or a point's two ends)."""
         path = np.asarray(path, dtype=float)
-        # no point of the path is further from its start than this: where the start is more
-        # than this and a radius from the structure and the ground, no point touches them
-        # (a distance changes no faster than the point moves)
-        reach = float(np.sqrt(np.max(np.sum((path - path[0]) ** 2, axis=1))))
-        clear = self.radius_m + reach + CLEAR_SLACK_M
-        if path[0, 2] > clear and self.proximity.distance(path[:1])[0] > clear:
+        centres = path[:, :3]
+        # no point of the body is further from the path's start than this: where the start is
+        # more than this from the structure and the ground, nothing touches them (a distance
+        # changes no faster than the point moves)
+        reach = float(np.sqrt(np.max(np.sum((centres - centres[0]) ** 2, axis=1))))
+        size = self.radius_m if self.body is None else self.body.reach_m
+        clear = size + reach + CLEAR_SLACK_M
+        if centres[0, 2] > clear and self.proximity.distance(centres[:1])[0] > clear:
             return []
+        if self.body is None or path.shape[1] < 7:
+            return self._sphere_along(centres, start_s, end_s)
+        return self._body_along(path, start_s, end_s)
+
+    def _sphere_along(self, path: np.ndarray, start_s: float, end_s: float) -> list[Contact]:
         if len(path) == 2:
             points = segment_points(path[0], path[1], self.radius_m / 4)
             times = np.linspace(start_s, end_s, len(points))
         else:
             points, times = dense_path(path, start_s, end_s, self.radius_m / 4)
-        found = []
-        for other, gaps in (
-            (STRUCTURE, self.proximity.distance(points)),
-            (GROUND, points[:, 2]),
-        ):
-            touching = np.flatnonzero(gaps < self.radius_m)
-            if len(touching):
-                i = int(touching[0])
-                found.append(Contact(other, float(times[i]), points[i], float(gaps[i])))
-        return found
+        gaps = (self.proximity.distance(points), points[:, 2])
+        return _first_contacts(gaps, self.radius_m, points, times)
+
+    def _body_along(self, poses: np.ndarray, start_s: float, end_s: float) -> list[Contact]:
+        """A quadrotor's points along its poses (each leg's attitude its start's)."""
+        centres, times = dense_path(poses[:, :3], start_s, end_s, BODY_SPACING_M)
+        joints = np.linspace(start_s, end_s, len(poses))
+        legs = np.clip(np.searchsorted(joints, times, side="right") - 1, 0, len(poses) - 1)
+        placed = self.body.placed(np.column_stack([centres, poses[legs, 3:7]]))
+        count, k = placed.shape[:2]
+        flat = placed.reshape(count * k, 3)
+        slack = np.tile(self.body.radii, count)
+        gaps = (self.proximity.distance(flat) - slack, flat[:, 2] - slack)
+        return _first_contacts(gaps, 0.0, np.repeat(centres, k, axis=0), np.repeat(times, k))
 
     def with_vehicles(
         self,
@@ -114,6 +137,20 @@ class ContactDetector:
                 when = start_s + fraction * (end_s - start_s)
                 found.append(Contact(name, when, where, distance))
         return found
+
+
+def _first_contacts(
+    gaps: tuple[np.ndarray, np.ndarray], radius_m: float, where: np.ndarray, times: np.ndarray
+) -> list[Contact]:
+    """The first sample closer than ``radius_m`` to the structure (``gaps[0]``) and the first
+    to the ground (``gaps[1]``), as contacts at the centre ``where`` was then."""
+    found = []
+    for other, gap in zip((STRUCTURE, GROUND), gaps):
+        touching = np.flatnonzero(gap < radius_m)
+        if len(touching):
+            i = int(touching[0])
+            found.append(Contact(other, float(times[i]), where[i], float(gap[i])))
+    return found
 
 
 class ContactWatch:

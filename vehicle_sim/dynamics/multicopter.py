@@ -12,25 +12,34 @@ one plus a bias (per run and axis) and noise (per step): the offset drifts.
 model. The wind (:mod:`mission.world.wind`) is sampled at the vehicle's true position at the
 start of each step, one vector a substep; so are the surfaces above and below each rotor (the
 ceiling and ground effects: :mod:`mission.world.surfaces`), held over the step.
+
+It starts hovering in trim: its velocity loop's integral already holds off the mean wind's
+drag where it is, as that of a vehicle that took off in the wind and climbed there would.
+The loops' tunable values (PX4's MPC_* parameters) can change between steps (:meth:`tune`).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from mission.config.autopilot_settings import AutopilotSettings
 from mission.config.planner_vehicle_settings import VehicleSettings
 from mission.config.settings import BoxPrimitive
 from mission.config.wind_settings import WindSettings
 from mission.world.frames import quaternion_matrix
 from mission.world.surfaces import VerticalSurfaces
 from mission.world.wind import VehicleWind
-from vehicle_sim.dynamics.closed_loop import ClosedLoop
+from vehicle_sim.dynamics.autopilot_loops import CONTROLLER_SIZE
+from vehicle_sim.dynamics.closed_loop import INTEGRAL, ClosedLoop
 from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     OPEN_AIR,
     POSITION,
     RATES,
     VELOCITY,
+    hover_drag,
     resting_state,
     rotor_offsets,
 )
@@ -59,10 +68,26 @@ class Multicopter:
         self.velocity_bias = (
             np.zeros(3) if drift_rng is None else drift_rng.normal(0.0, loops.velocity_bias_m_s, 3)
         )
-        self.state = np.concatenate([resting_state(home, loop.body), np.zeros(3)])
+        self.state = self._resting(home)
+        if wind is not None:
+            self.state[INTEGRAL] = -hover_drag(loop.body, wind.mean_at(home)) / loop.body.mass_kg
+        self.settings: AutopilotSettings = loop.loops
+        self.tuning = loop.tuning.copy()
         self.offset = np.zeros(3)  # believed - true position
         self.target: np.ndarray | None = None
-        self.path = self.state[POSITION][None].copy()  # true positions over the last step
+        self.path = self._pose()[None]  # true poses (position, attitude) over the last step
+
+    def _resting(self, position: np.ndarray) -> np.ndarray:
+        return np.concatenate([resting_state(position, self.loop.body), np.zeros(CONTROLLER_SIZE)])
+
+    def _pose(self) -> np.ndarray:
+        return np.concatenate([self.state[POSITION], self.state[ATTITUDE]])
+
+    def tune(self, field: str, value: float) -> None:
+        """Set one of the loops' tunable values (an :class:`AutopilotSettings` field) from the
+        next step on; FieldProblem (naming the field) where the loops could not take it."""
+        self.settings = replace(self.settings, **{field: value})  # validated as the scenario's
+        self.tuning = np.array(self.settings.tuning())
 
     @classmethod
     def at(
@@ -141,8 +166,7 @@ class Multicopter:
     def stop_at(self, position: np.ndarray) -> None:
         """Stopped dead at ``position`` (a crash): still, level, believing the truth, no
         target."""
-        self.state = np.concatenate([resting_state(position, self.loop.body), np.zeros(3)])
-        self.state[RATES] = 0.0
+        self.state = self._resting(position)
         self.offset = np.zeros(3)
         self.target = None
 
@@ -156,9 +180,15 @@ class Multicopter:
         before = self.believed
         target = before if self.target is None else self.target
         wind = CALM if self.wind is None else self.wind.over_step(self.truth, self.loop.substeps)
-        start = self.truth
+        start = self._pose()
         self.state, path = self.loop.advance(
-            self.state, target, self.offset, speed_limit_m_s, wind, self._surfaces_near()
+            self.state,
+            target,
+            self.offset,
+            speed_limit_m_s,
+            wind,
+            self._surfaces_near(),
+            self.tuning,
         )
         if self.drift_rng is not None:  # the filter's velocity error, integrated over the step
             noise = self.drift_rng.normal(0.0, self.loop.loops.velocity_noise_m_s, 3)
@@ -167,5 +197,5 @@ class Multicopter:
             kick = rng.normal(0.0, noise_m, 3)
             self.state[POSITION] += kick
             self.offset = self.offset - kick
-        self.path = np.vstack([start, path[:-1], self.truth])
+        self.path = np.vstack([start, path[:-1], self._pose()])
         return self.believed - before

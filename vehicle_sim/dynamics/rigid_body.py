@@ -3,18 +3,21 @@ dynamics"), as casadi expressions: its state's derivative and one integration su
 :mod:`~vehicle_sim.dynamics.closed_loop` folds with the autopilot's loops over a whole
 simulation step in one Function call.
 
-The model is PX4 SIH's (``simulator_sih/sih.cpp``): thrust along the body's z axis from four
-rotors whose thrust follows the command with a first-order lag (``motor_tau_s``), moments from
-the rotors' arms and their reaction torques, linear body drag against the air's velocity
-(``-k (v - wind)``) and linear rotational damping (``-k omega``), gravity. Frames: ENU world,
-FLU body (x nose, y left, z up); the attitude is the unit quaternion (w, x, y, z) taking body
-to world.
+The rigid body and rotors are PX4 SIH's (``simulator_sih/sih.cpp``): thrust along the body's z
+axis from four rotors whose thrust follows the command with a first-order lag
+(``motor_tau_s``), moments from the rotors' levers and their reaction torques, linear
+rotational damping (``-k omega``), gravity. The rotors sit at (+-L, +-L) in the body's x-y
+plane, ``rotor_height_m`` above the centre of mass. The air's forces are RotorPy's
+(``rotorpy/vehicles/multirotor.py``): each rotor's drag -omega_i k_d v_i in the rotor's plane
+at its hub, v_i the air's velocity there (the body's velocity less the wind, plus its rotation's),
+omega_i = sqrt(T_i / k_eta); and the frame's quadratic parasitic drag at the centre of mass.
+A hub's drag above the centre of mass also pitches the body. Frames: ENU world, FLU body (x
+nose, y left, z up); the attitude is the unit quaternion (w, x, y, z) taking body to world.
 
-Near a surface each rotor's thrust is multiplied by the ceiling or ground effect's gain
-(:class:`~mission.config.multicopter_settings.MulticopterSettings`) for its own distance to the
-surface above or below it (the rotors lie in the body's x-y plane through its centre): a body
-tilted under a deck makes more thrust on its upper side, and a moment. The rotors' reaction
-torque stays as commanded (the law holds the rotor's power: its torque does not change).
+Near a surface each rotor's thrust is multiplied by the ceiling or ground law's gain
+(:mod:`mission.config.proximity_laws`) for its own distance to the surface above or below it:
+a body tilted under a deck makes more thrust on its upper side, and a moment. The rotors'
+reaction torque and drag stay as their speed makes them (the law holds the rotor's power).
 
 State (17): position (3, m), velocity (3, m/s), attitude (4), body rates (3, rad/s), rotor
 thrusts (4, N, away from surfaces). Inputs over a step: the rotors' commands (4, 0..1), the
@@ -33,6 +36,7 @@ import casadi as ca
 import numpy as np
 
 from mission.config.multicopter_settings import STANDARD_GRAVITY, MulticopterSettings
+from mission.config.proximity_laws import ceiling_gain, ground_gain
 
 STATE_SIZE = 17
 POSITION, VELOCITY, ATTITUDE, RATES, THRUSTS = (
@@ -61,16 +65,12 @@ def rotation(q: ca.SX) -> ca.SX:
 
 
 def rotor_offsets(settings: MulticopterSettings) -> np.ndarray:
-    """(4, 3): each rotor's centre in the body frame (FLU, m)."""
+    """(4, 3): each rotor's hub in the body frame (FLU, m): at (+-L, +-L), L the lever,
+    ``rotor_height_m`` above the centre of mass."""
     angles = np.radians(ROTOR_ANGLES_DEG)
-    return settings.arm_m * np.column_stack([np.cos(angles), np.sin(angles), np.zeros(4)])
-
-
-def proximity_gain(k: float, radius_m: float, clip_radii: float, distance_m):
-    """A rotor's thrust gain ``distance_m`` from a surface: 1 / (1 - k (R/d)^2), d held at
-    ``clip_radii`` rotor radii closer in (a casadi expression; numbers give a casadi DM)."""
-    held = ca.fmax(distance_m, clip_radii * radius_m)
-    return 1 / (1 - k * (radius_m / held) ** 2)
+    arm = settings.rotor_arm_m
+    height = np.full(4, settings.rotor_height_m)
+    return np.column_stack([arm * np.cos(angles), arm * np.sin(angles), height])
 
 
 def near_surfaces(settings: MulticopterSettings, state: ca.SX, surfaces: ca.SX) -> ca.SX:
@@ -78,14 +78,35 @@ def near_surfaces(settings: MulticopterSettings, state: ca.SX, surfaces: ca.SX) 
     (``surfaces``: the four rotors' heights above, then below)."""
     s = settings
     heights = state[2] + (rotation(state[ATTITUDE]) @ ca.DM(rotor_offsets(s).T))[2, :].T
-    gain = ca.DM.ones(4)
-    for k, gap in (
-        (s.ceiling_effect_k, surfaces[:4] - heights),
-        (s.ground_effect_k, heights - surfaces[4:]),
-    ):
-        if k > 0:
-            gain = gain * proximity_gain(k, s.rotor_radius_m, s.proximity_clip_radii, gap)
-    return gain
+    above = ceiling_gain(s, surfaces[:4] - heights, ca.fmax)
+    below = ground_gain(s, heights - surfaces[4:], ca.fmax)
+    return above * below
+
+
+def air_forces(settings: MulticopterSettings, state: ca.SX, wind: ca.SX) -> tuple[ca.SX, ca.SX]:
+    """(force, moment) of the air on the body, both in the body frame: the rotors' drag at
+    their hubs and the frame's parasitic drag (RotorPy's model)."""
+    s = settings
+    velocity, q, rates, thrusts = (state[part] for part in (VELOCITY, ATTITUDE, RATES, THRUSTS))
+    air = rotation(q).T @ (velocity - wind)  # the body's velocity through the air, body frame
+    drag = -ca.norm_2(air) * ca.DM(s.parasitic_drag_n_s2_m2) * air
+    moment = ca.DM.zeros(3)
+    in_plane = ca.DM([s.rotor_drag_coefficient, s.rotor_drag_coefficient, 0.0])
+    for hub, thrust in zip(rotor_offsets(s), ca.vertsplit(thrusts)):
+        speed = ca.sqrt(ca.fmax(thrust, 0) / s.rotor_thrust_coefficient)
+        hub_force = -speed * in_plane * (air + ca.cross(rates, ca.DM(hub)))
+        drag += hub_force
+        moment += ca.cross(ca.DM(hub), hub_force)
+    return drag, moment
+
+
+def hover_drag(settings: MulticopterSettings, wind: np.ndarray) -> np.ndarray:
+    """(3,) the air's force (N, world) on the body hovering level and still in ``wind``."""
+    state = ca.SX.sym("x", STATE_SIZE)
+    air = ca.SX.sym("w", 3)
+    drag = ca.Function("drag", [state, air], [air_forces(settings, state, air)[0]])
+    resting = resting_state(np.zeros(3), settings)
+    return np.asarray(drag(resting, np.asarray(wind, dtype=float))).ravel()
 
 
 def derivative(
@@ -97,16 +118,15 @@ def derivative(
     velocity, q, rates, thrusts = (state[part] for part in (VELOCITY, ATTITUDE, RATES, THRUSTS))
     lifting = thrusts if gains is None else thrusts * gains
     inertia = ca.DM(np.diag(s.inertia_kg_m2))
-    force = rotation(q) @ ca.vertcat(0, 0, ca.sum1(lifting))
-    force += -s.drag_n_per_m_s * (velocity - wind) - ca.vertcat(0, 0, s.mass_kg * STANDARD_GRAVITY)
+    drag, moment = air_forces(s, state, wind)
+    force = rotation(q) @ (ca.vertcat(0, 0, ca.sum1(lifting)) + drag)
+    force -= ca.vertcat(0, 0, s.mass_kg * STANDARD_GRAVITY)
     torque_per_thrust = s.rotor_torque_max_n_m / s.rotor_thrust_max_n
-    moment = -s.rotational_damping_n_m_per_rad_s * rates
-    for angle, spin, lift, thrust in zip(
-        ROTOR_ANGLES_DEG, ROTOR_SPINS, ca.vertsplit(lifting), ca.vertsplit(thrusts)
+    moment -= s.rotational_damping_n_m_per_rad_s * rates
+    for (arm_x, arm_y, _), spin, lift, thrust in zip(
+        rotor_offsets(s), ROTOR_SPINS, ca.vertsplit(lifting), ca.vertsplit(thrusts)
     ):
-        arm_x = s.arm_m * math.cos(math.radians(angle))
-        arm_y = s.arm_m * math.sin(math.radians(angle))
-        # the arm's moment (r x F for F along body z) and the reaction to the rotor's spin
+        # the lever's moment (r x F for F along body z) and the reaction to the rotor's spin
         moment += ca.vertcat(arm_y * lift, -arm_x * lift, -spin * torque_per_thrust * thrust)
     angular = ca.solve(inertia, moment - ca.cross(rates, inertia @ rates))
     spin_rate = 0.5 * ca.vertcat(

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.config.autopilot_settings import PX4_PARAMETERS
 from mission.config.settings import Scenario
 from mission.config.vehicle_parameters import PARAMETERS, ParameterSpec
 
@@ -114,6 +115,8 @@ def vehicle_parameters(
         "SIM_RADIUS": v.radius_m,
         "SIM_FAIL_ENABLE": 0,
     }
+    for name, field in PX4_PARAMETERS.items():
+        values[name] = getattr(v.autopilot, field)
     rows = [
         Parameter(spec, INT32 if spec.integer else REAL32, float(values[spec.name]))
         for spec in PARAMETERS
