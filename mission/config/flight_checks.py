@@ -43,6 +43,13 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
         "multicopter.rate_hz",
         f"must be at most {MAX_RATE_HZ:g} Hz, got {body.rate_hz:g}",
     )
+    hover = body.mass_kg * STANDARD_GRAVITY / 4
+    require(
+        body.rotor_thrust_max_n <= MAX_THRUST_TO_WEIGHT * hover,
+        "multicopter.rotor_thrust_max_n",
+        f"must be at most {MAX_THRUST_TO_WEIGHT:g} times a quarter of the weight "
+        f"({hover:.2f} N; a racing quadrotor's thrust-to-weight)",
+    )
     h = 1.0 / body.rate_hz
     constants = [("motor_tau_s", "the motors' lag", body.motor_tau_s)]
     full_speed = math.sqrt(body.rotor_thrust_max_n / body.rotor_thrust_coefficient)
@@ -76,13 +83,6 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
         f"{gain:g} with the motors' {lag:g} s lag damps the rate loop {damping:.2f} "
         f"(at least {MIN_RATE_LOOP_DAMPING:g}: K tau at most "
         f"{1 / (4 * MIN_RATE_LOOP_DAMPING**2):g})",
-    )
-    hover = body.mass_kg * STANDARD_GRAVITY / 4
-    require(
-        body.rotor_thrust_max_n <= MAX_THRUST_TO_WEIGHT * hover,
-        "multicopter.rotor_thrust_max_n",
-        f"must be at most {MAX_THRUST_TO_WEIGHT:g} times a quarter of the weight "
-        f"({hover:.2f} N; a racing quadrotor's thrust-to-weight)",
     )
     require(
         body.rotor_torque_max_n_m <= body.rotor_thrust_max_n * body.lever_m,

@@ -8,7 +8,7 @@ with the dynamics, so that the settings can refuse a law that is infinite where 
   ceiling by momentum theory: T/T0 = gamma^2 with
   gamma = (1 - a1 delta^2) / 2 + sqrt((1 - a1 delta^2)^2 + (a0 / 8) delta^2) / 2, delta = R / d,
   and their constants a0 = 1.6, a1 = 0 (as a public implementation of the model carries them;
-  we could not read the paper's text). It gives 1.10 at d = R, 1.37 at R/2 and 2.33 at R/4.
+  we could not read the paper's text). It gives 1.10 at d = R, 1.37 at R/2 and 2.32 at R/4.
 - **Ground, measured**: Sanchez-Cuevas, Heredia and Ollero (2017, "Characterization of the
   aerodynamic ground effect and its influence in multirotor control", Int. J. Aerospace Eng.),
   eq. 7, which adds the neighbouring rotors' images and the body's lift to Cheeseman and

@@ -170,9 +170,9 @@ FILE_CASES = [
             ),
             (
                 "drag",
-                FLOWN % "multicopter: {drag_n_per_m_s: 1.0e+9}",
-                "multicopter.mass_kg",
-                "mass over drag",
+                FLOWN % "multicopter: {rotor_drag_coefficient: 1.0e+9}",
+                "multicopter.rotor_drag_coefficient",
+                "mass over the rotors' drag",
             ),
             ("rate-1e6", FLOWN % "multicopter: {rate_hz: 1.0e+6}", "rate_hz", "at most 2000"),
             ("rate-1e300", FLOWN % "multicopter: {rate_hz: 1.0e+300}", "rate_hz", "at most"),

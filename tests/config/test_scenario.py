@@ -156,14 +156,14 @@ BAD_INPUTS = [
         "tilt of 90 degrees",
         "vehicle: {autopilot: {tilt_max_deg: 90}}\n",
         "vehicle.autopilot.tilt_max_deg",
-        "[5, 90) degrees",
+        "[20, 89] degrees",
     ),
     # settings in range alone and then fatal or meaningless in flight (found by a red team)
     (
         "tilt of 1e-9 degrees",
         "vehicle: {autopilot: {tilt_max_deg: 1.0e-9}}\n",
         "vehicle.autopilot.tilt_max_deg",
-        "[5, 90) degrees",
+        "[20, 89] degrees",
     ),
     (
         "velocity bias 1e300",
@@ -181,7 +181,7 @@ BAD_INPUTS = [
         "torque 1e300",
         "vehicle: {dynamics: multicopter, multicopter: {rotor_torque_max_n_m: 1.0e+300}}\n",
         "vehicle.multicopter.rotor_torque_max_n_m",
-        "rotor_thrust_max_n x arm_m",
+        "rotor_thrust_max_n x lever_m",
     ),
     (
         "mass 1e30",
@@ -262,15 +262,33 @@ BAD_INPUTS = [
     ),
     (
         "overlapping rotors",
-        "vehicle: {multicopter: {rotor_radius_m: 0.2}}\n",
+        "vehicle: {multicopter: {rotor_radius_m: 0.21}}\n",
         "vehicle.multicopter.rotor_radius_m",
         "would overlap",
     ),
     (
-        "an infinite ceiling gain",
-        "vehicle: {multicopter: {ceiling_effect_k: 0.3}}\n",
-        "vehicle.multicopter.ceiling_effect_k",
+        "an infinite ground gain",
+        "vehicle: {multicopter: {proximity_clip_radii: 0.25}}\n",
+        "vehicle.multicopter.proximity_clip_radii",
         "infinite",
+    ),
+    (
+        "a negative rotor radius",
+        "vehicle: {multicopter: {rotor_radius_m: -0.1}}\n",
+        "vehicle.multicopter.rotor_radius_m",
+        "must be positive",
+    ),
+    (
+        "an unknown ceiling law",
+        "vehicle: {multicopter: {ceiling_model: strong}}\n",
+        "vehicle.multicopter.ceiling_model",
+        "must be one of",
+    ),
+    (
+        "a gain outside its PX4 parameter's range",
+        "vehicle: {autopilot: {velocity_gain_per_s: 9}}\n",
+        "vehicle.autopilot.velocity_gain_per_s",
+        "MPC_XY_VEL_P_ACC 9 must be in [1.2, 5]",
     ),
     (
         "empty structure",

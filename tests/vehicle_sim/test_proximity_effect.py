@@ -1,7 +1,7 @@
-"""The ceiling and ground effects: the thrust gain against Cheeseman and Bennett's law at three
-distances, a hovering body lifted by it as the drag law says, a body tilted under a deck rolled
-further, and a vehicle hovering under the deck that a gust and the ceiling effect push into it
-caught by the contact detection (along its substeps, between two steps' ends)."""
+"""The ceiling and ground effects: the measured ceiling law (Hsiao and Chirarattananon 2019)
+against its formula at five distances, the measured ground law (Sanchez-Cuevas et al. 2017)
+and the image law against theirs, a hovering body lifted as the law says, a body tilted under
+a deck rolled further, and a vehicle flown up to the deck pulled into it by the effect."""
 
 from __future__ import annotations
 
@@ -13,43 +13,67 @@ import pytest
 
 from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
+from mission.config.proximity_laws import ceiling_gain, ground_gain
 from mission.config.scenario import load_scenario
 from mission.world.proximity import StructureProximity
 from mission.world.surfaces import VerticalSurfaces
 from tests.vehicle_sim.rigid_body_alone import RigidBody
 from vehicle_sim.dynamics.contact import STRUCTURE, ContactDetector
+from vehicle_sim.dynamics.contact_body import ContactBody
 from vehicle_sim.dynamics.multicopter import Multicopter
-from vehicle_sim.dynamics.rigid_body import (
-    OPEN_AIR,
-    POSITION,
-    RATES,
-    proximity_gain,
-    resting_state,
-)
+from vehicle_sim.dynamics.rigid_body import OPEN_AIR, POSITION, RATES, resting_state
 
-VEHICLE = load_scenario("along").vehicle
+VEHICLE = replace(load_scenario("along").vehicle, dynamics="multicopter", radius_m=None)
 BODY = VEHICLE.multicopter
-R = BODY.rotor_radius_m
+R, H, L = BODY.rotor_radius_m, BODY.rotor_height_m, BODY.lever_m
 DECK_UNDERSIDE_M = 8.0  # the along scenario's
-GAP_M = 0.4  # the body's centre under the deck: 15 cm from touching it
-GUST_M_S = 1.2  # straight up for a second
+STILL = replace(BODY, parasitic_drag_n_s2_m2=(0.0, 0.0, 0.0), rotor_drag_coefficient=0.0)
 
 
 def _hover_command() -> np.ndarray:
     return np.full(4, BODY.mass_kg * G / 4 / BODY.rotor_thrust_max_n)
 
 
+def _hsiao(d: float) -> float:
+    # T/T0 = gamma^2, gamma = 1/2 + sqrt(1 + (1.6 / 8) (R / d)^2) / 2 (a0 = 1.6, a1 = 0)
+    return (0.5 + 0.5 * math.sqrt(1 + 0.2 * (R / d) ** 2)) ** 2
+
+
+@pytest.mark.parametrize("radii", [4.0, 2.0, 1.0, 0.75, 0.5])
+def test_the_measured_ceiling_law_is_its_formula_at_five_distances(radii):
+    assert ceiling_gain(BODY, radii * R) == pytest.approx(_hsiao(radii * R), rel=1e-12)
+
+
+def test_the_measured_ceiling_law_gives_the_published_gains():
+    # 1.10 at R, 1.37 at R / 2, 2.32 at R / 4 (the last inside the default clip: unclipped)
+    unclipped = replace(BODY, proximity_clip_radii=0.1, ground_model="none")
+    gains = [ceiling_gain(unclipped, k * R) for k in (1.0, 0.5, 0.25)]
+    assert gains == pytest.approx([1.0977, 1.3708, 2.3247], abs=1e-4)
+
+
+@pytest.mark.parametrize("height_radii", [3.0, 1.0, 0.5])
+def test_the_measured_ground_law_is_sanchez_cuevas_eq_7(height_radii):
+    z, d, b = height_radii * R, 2 * L, 2 * math.sqrt(2) * L  # neighbours, opposite rotors
+    denominator = (
+        1
+        - (R / (4 * z)) ** 2
+        - R**2 * z / math.sqrt(d**2 + 4 * z**2) ** 3
+        - R**2 / 2 * z / math.sqrt(2 * d**2 + 4 * z**2) ** 3
+        - 2 * R**2 * z * 2.0 / math.sqrt(b**2 + 4 * z**2) ** 3
+    )
+    assert ground_gain(BODY, z) == pytest.approx(1 / denominator, rel=1e-12)
+
+
 @pytest.mark.parametrize("radii, cheeseman_bennett", [(0.5, 4 / 3), (1.0, 16 / 15), (2.0, 64 / 63)])
-def test_the_gain_is_cheeseman_and_bennetts_at_three_distances(radii, cheeseman_bennett):
-    # T/T0 = 1 / (1 - (R / 4 d)^2): 1 / (1 - 1/4), 1 / (1 - 1/16), 1 / (1 - 1/64)
-    gain = float(proximity_gain(BODY.ceiling_effect_k, R, BODY.proximity_clip_radii, radii * R))
-    assert gain == pytest.approx(cheeseman_bennett, rel=1e-12)
+def test_the_image_law_is_cheeseman_and_bennetts(radii, cheeseman_bennett):
+    image = replace(BODY, ceiling_model="image", ground_model="image")
+    assert ceiling_gain(image, radii * R) == pytest.approx(cheeseman_bennett, rel=1e-12)
+    assert ground_gain(image, radii * R) == pytest.approx(cheeseman_bennett, rel=1e-12)
 
 
 def test_closer_than_the_clip_the_gain_stays_as_it_is_there():
-    at_clip = float(proximity_gain(1 / 16, R, 0.5, 0.5 * R))
-    assert float(proximity_gain(1 / 16, R, 0.5, 0.1 * R)) == at_clip
-    assert float(proximity_gain(1 / 16, R, 0.5, -1.0)) == at_clip  # a rotor through it
+    at_clip = ceiling_gain(BODY, BODY.proximity_clip_radii * R)
+    assert ceiling_gain(BODY, 0.1 * R) == at_clip and ceiling_gain(BODY, -1.0) == at_clip
 
 
 def _lift_after(settings, surfaces, seconds: float) -> float:
@@ -59,89 +83,72 @@ def _lift_after(settings, surfaces, seconds: float) -> float:
 
 
 @pytest.mark.parametrize("where", ["ceiling", "ground"])
-def test_a_hovering_body_near_a_surface_rises_as_the_drag_law_says(where):
-    # every rotor within the clip distance throughout (rising 2 cm from the ground): the gain
-    # is 4/3, an excess of g / 3
-    gap = 0.2 * R
+def test_a_hovering_body_near_a_surface_rises_as_the_law_says(where):
+    # every rotor within the clip distance throughout (rising 2 cm): a constant excess
+    # (gain - 1) g, no drag (STILL): the rise g t^2 (gain - 1) / 2
+    gap, rotors = 0.2 * R, 5.0 + H
     if where == "ceiling":
-        surfaces = np.array([5.0 + gap] * 4 + [-1e6] * 4)
+        surfaces, gain = np.array([rotors + gap] * 4 + [-1e6] * 4), ceiling_gain(BODY, gap)
     else:
-        surfaces = np.array([1e6] * 4 + [5.0 - gap] * 4)
-    t, m, k = 0.1, BODY.mass_kg, BODY.drag_n_per_m_s
-    excess = G / 3
-    expected = excess * m / k * (t - m / k * (1 - math.exp(-k * t / m)))
-    assert _lift_after(BODY, surfaces, t) == pytest.approx(expected, rel=1e-6)
-    assert _lift_after(BODY, OPEN_AIR, t) == pytest.approx(0.0, abs=1e-12)
-    off = replace(BODY, ceiling_effect_k=0.0, ground_effect_k=0.0)
+        surfaces, gain = np.array([1e6] * 4 + [rotors - gap] * 4), ground_gain(BODY, gap)
+    t = 0.1
+    assert _lift_after(STILL, surfaces, t) == pytest.approx((gain - 1) * G * t**2 / 2, rel=1e-6)
+    assert _lift_after(STILL, OPEN_AIR, t) == pytest.approx(0.0, abs=1e-12)
+    off = replace(STILL, ceiling_model="none", ground_model="none")
     assert _lift_after(off, surfaces, t) == pytest.approx(0.0, abs=1e-12)
 
 
 def test_a_body_rolled_under_a_deck_is_rolled_further():
     roll = math.radians(5.0)  # about the nose: the left rotors rise toward the deck
     tilt = np.array([math.cos(roll / 2), math.sin(roll / 2), 0.0, 0.0])
-    state = resting_state([0.0, 0.0, 5.0], BODY, tilt)
-    body = RigidBody(BODY, 0.02)
-    deck = np.array([5.1] * 4 + [-1e6] * 4)
-    under = body.advance(state, _hover_command(), np.zeros(3), deck)
+    state = resting_state([0.0, 0.0, 5.0], STILL, tilt)
+    body = RigidBody(STILL, 0.02)  # no drag: the thrusts' moments alone
+    deck = 5.0 + H + 0.1
+    under = body.advance(state, _hover_command(), np.zeros(3), np.array([deck] * 4 + [-1e6] * 4))
     in_open_air = body.advance(state, _hover_command(), np.zeros(3))
-    # by hand: two rotors a side, arm_y = arm sin 45 from the roll axis, their heights
-    # +- arm_y sin(roll); each side's gain 1 / (1 - (R / 4 d)^2) at its distance d
-    arm_y = BODY.arm_m * math.sin(math.radians(45))
+    # by hand: two rotors a side at y = +-L, H above the centre; rolled, their heights
+    # 5 + H cos(roll) +- L sin(roll); each side's gain the law's at its distance to the deck
     thrust = state[-4]  # each rotor's, as the state starts
-    left, right = (1 / (1 - (R / 4 / (0.1 - s * arm_y * math.sin(roll))) ** 2) for s in (1, -1))
-    moment = 2 * arm_y * thrust * (left - right)
-    expected_rate = moment / BODY.inertia_kg_m2[0] * 0.02
+    left, right = (
+        _hsiao(deck - 5.0 - H * math.cos(roll) - s * L * math.sin(roll)) for s in (1, -1)
+    )
+    expected_rate = 2 * L * thrust * (left - right) / BODY.inertia_kg_m2[0] * 0.02
     assert under[RATES][0] == pytest.approx(expected_rate, rel=0.03)
     assert abs(in_open_air[RATES][0]) < 1e-9
 
 
-class _Updraft:
-    """A gust straight up for ``seconds``, then still air (the wind of the parts around the
-    contact check: the body, the surfaces and the detector are the real ones)."""
-
-    def __init__(self, speed_m_s: float, seconds: float, step_s: float) -> None:
-        self.speed, self.steps_left = speed_m_s, round(seconds / step_s)
-
-    def over_step(self, position, substeps: int) -> np.ndarray:
-        up = self.speed if self.steps_left > 0 else 0.0
-        self.steps_left -= 1
-        return np.tile([0.0, 0.0, up], (substeps, 1))
-
-
-def _fly_under_the_deck(along_world, vehicle, gust_m_s: float):
-    """(the highest point, the contacts along its substeps, those between its steps' ends)."""
-    home = np.array([0.0, 0.0, DECK_UNDERSIDE_M - GAP_M])
+def _fly_up_to_the_deck(along_world, vehicle, rotor_gap_m: float):
+    """A vehicle 1 m under the deck told to climb until its rotors are ``rotor_gap_m`` under
+    it: (the rotors' least gap to the deck, the contacts along its substeps)."""
+    h = vehicle.multicopter.rotor_height_m
+    home = np.array([0.0, 0.0, DECK_UNDERSIDE_M - h - 1.0])
     body = Multicopter.at(home, vehicle, 0.5, surfaces=VerticalSurfaces(along_world.structure))
-    body.wind = _Updraft(gust_m_s, 1.0, 0.5)
-    body.hold()
-    detector = ContactDetector(StructureProximity(along_world.structure), vehicle.radius_m)
-    along, ends, peak = [], [], 0.0
-    for step in range(6):
+    body.target = home + [0.0, 0.0, 1.0 - rotor_gap_m]
+    shape = ContactBody.of(vehicle.multicopter)
+    detector = ContactDetector(StructureProximity(along_world.structure), vehicle.radius_m, shape)
+    least, contacts = math.inf, []
+    for step in range(12):
         body.step(0.5, 3.0, np.random.default_rng(0), 0.0)
-        peak = max(peak, float(body.path[:, 2].max()))
-        start_s, end_s = 0.5 * step, 0.5 * (step + 1)
-        along += detector.along(body.path, start_s, end_s)
-        ends += detector.along(body.path[[0, -1]], start_s, end_s)  # the step's ends only
-    return peak, along, ends
+        least = min(least, DECK_UNDERSIDE_M - h - float(body.path[:, 2].max()))
+        contacts += detector.along(body.path, 0.5 * step, 0.5 * (step + 1))
+    return least, contacts
 
 
-def test_a_gust_and_the_ceiling_effect_push_a_hovering_vehicle_into_the_deck_caught(along_world):
-    peak, contacts, between_ends = _fly_under_the_deck(along_world, VEHICLE, GUST_M_S)
-    assert [c.other for c in contacts] == [STRUCTURE] and between_ends == []
-    touch = contacts[0]
-    assert DECK_UNDERSIDE_M - touch.position_m[2] < VEHICLE.radius_m
-    assert 1.0 < touch.time_s < 1.5  # rising past its step's start, down again by its end
-    # the same gust without the ceiling effect stays clear: the effect made the difference
-    off = replace(VEHICLE, multicopter=replace(BODY, ceiling_effect_k=0.0))
-    peak_off, contacts_off, _ = _fly_under_the_deck(along_world, off, GUST_M_S)
-    assert contacts_off == [] and peak_off < peak
-    # and in still air the autopilot holds its place within 2 cm against the ceiling effect
-    peak_calm, calm_contacts, _ = _fly_under_the_deck(along_world, VEHICLE, 0.0)
-    assert calm_contacts == [] and peak_calm == pytest.approx(DECK_UNDERSIDE_M - GAP_M, abs=0.02)
+def test_the_ceiling_effect_pulls_a_vehicle_flown_up_to_the_deck_into_it(along_world):
+    off = replace(VEHICLE, multicopter=replace(BODY, ceiling_model="none"))
+    # told to stop with its rotors 0.20 m under the deck: 8 cm closer with the effect
+    least_on, contacts_on = _fly_up_to_the_deck(along_world, VEHICLE, 0.20)
+    least_off, contacts_off = _fly_up_to_the_deck(along_world, off, 0.20)
+    assert contacts_on == contacts_off == []
+    assert least_off == pytest.approx(0.20, abs=0.01) and least_on < least_off - 0.05
+    # at 0.15 m the effect pulls it into the deck, which it would not touch without
+    _, contacts_on = _fly_up_to_the_deck(along_world, VEHICLE, 0.15)
+    least_off, contacts_off = _fly_up_to_the_deck(along_world, off, 0.15)
+    assert contacts_on and contacts_on[0].other == STRUCTURE and contacts_off == []
 
 
 def test_overlapping_rotors_and_an_infinite_gain_are_refused():
     with pytest.raises(FieldProblem, match="overlap"):
-        replace(BODY, rotor_radius_m=0.15)
+        replace(BODY, rotor_radius_m=0.21)
     with pytest.raises(FieldProblem, match="infinite"):
-        replace(BODY, ceiling_effect_k=0.25, proximity_clip_radii=0.5)
+        replace(BODY, proximity_clip_radii=0.25)

@@ -1,12 +1,13 @@
-"""The quadrotor's rigid body against closed-form answers: free fall with linear drag, the
-motors' first-order lag, the terminal velocity of a constant tilt, the signs of the rotors'
-moments, and the settings a body cannot have."""
+"""The quadrotor's rigid body against closed-form answers: free fall with quadratic drag, the
+air's force and moment on a hovering body, the motors' first-order lag, a wind carrying the
+body, the signs of the rotors' moments, and the settings a body cannot have."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import replace
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -18,8 +19,10 @@ from vehicle_sim.dynamics.rigid_body import (
     ATTITUDE,
     POSITION,
     RATES,
+    STATE_SIZE,
     THRUSTS,
     VELOCITY,
+    air_forces,
     resting_state,
     substeps_of,
 )
@@ -44,19 +47,39 @@ def test_a_step_is_cut_into_equal_substeps_at_the_rate_or_faster(body):
     assert body.substeps == 125 and substeps_of(0.5, 300.0) == 150 and substeps_of(0.01, 250) == 3
 
 
-def test_free_fall_with_the_motors_off_follows_the_drag_law(body):
-    m, k = SETTINGS.mass_kg, SETTINGS.drag_n_per_m_s
+def test_free_fall_with_the_motors_off_follows_the_quadratic_drag_law(body):
+    # rotors stopped: no rotor drag, the frame's c_Dz v^2 alone; v_t = sqrt(m g / c),
+    # v(t) = -v_t tanh(g t / v_t), the drop (v_t^2 / g) ln cosh(g t / v_t)
+    m, c = SETTINGS.mass_kg, SETTINGS.parasitic_drag_n_s2_m2[2]
     still = resting_state([0.0, 0.0, 100.0], SETTINGS)
     still[THRUSTS] = 0.0
     state = _fly(body, still, [0] * 4, 4)  # 2 s
-    expected_drop = (m * G / k) * (2.0 - (m / k) * (1 - math.exp(-k * 2.0 / m)))
-    assert state[POSITION][2] == pytest.approx(100.0 - expected_drop, abs=1e-6)
-    assert state[VELOCITY][2] == pytest.approx(
-        -(m * G / k) * (1 - math.exp(-k * 2.0 / m)), abs=1e-6
-    )
+    terminal = math.sqrt(m * G / c)
+    drop = terminal**2 / G * math.log(math.cosh(G * 2.0 / terminal))
+    assert state[POSITION][2] == pytest.approx(100.0 - drop, abs=1e-6)
+    assert state[VELOCITY][2] == pytest.approx(-terminal * math.tanh(G * 2.0 / terminal), abs=1e-6)
     # and without drag, g t^2 / 2
-    no_drag = RigidBody(replace(SETTINGS, drag_n_per_m_s=0.0), STEP_S)
+    no_drag = RigidBody(replace(SETTINGS, parasitic_drag_n_s2_m2=(0.0, 0.0, 0.0)), STEP_S)
     assert _fly(no_drag, still, [0] * 4, 2)[2] == pytest.approx(100.0 - G * 1.0**2 / 2, abs=1e-9)
+
+
+def test_the_airs_force_and_moment_on_a_hovering_body_are_rotorpys():
+    # level, still, in a 5 m/s wind along x: each rotor's drag k_d omega W in its plane at its
+    # hub (omega = sqrt(T / k_eta), T a quarter of the weight), the frame's c_Dx W^2; the hubs
+    # rotor_height_m above the centre of mass pitch the body with the rotors' drag
+    state_symbol, wind_symbol = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("w", 3)
+    air = ca.Function(
+        "air", [state_symbol, wind_symbol], list(air_forces(SETTINGS, state_symbol, wind_symbol))
+    )
+    hovering = resting_state([0.0, 0.0, 10.0], SETTINGS)
+    force, moment = (np.asarray(v).ravel() for v in air(hovering, [5.0, 0.0, 0.0]))
+    s = SETTINGS
+    omega = math.sqrt(s.mass_kg * G / 4 / s.rotor_thrust_coefficient)
+    rotors = 4 * s.rotor_drag_coefficient * omega * 5.0
+    assert force == pytest.approx(
+        [rotors + s.parasitic_drag_n_s2_m2[0] * 25.0, 0.0, 0.0], rel=1e-12
+    )
+    assert moment == pytest.approx([0.0, s.rotor_height_m * rotors, 0.0], rel=1e-12, abs=1e-15)
 
 
 def test_the_rotors_follow_their_command_with_a_first_order_lag(body):
@@ -74,24 +97,15 @@ def test_hovering_thrust_holds_a_level_body_still(body):
     assert np.abs(after[POSITION] - state[POSITION]).max() < 1e-9
 
 
-def test_a_constant_tilt_reaches_the_terminal_velocity_of_its_drag(body):
-    tilt = math.radians(20.0)
-    q = np.array([math.cos(tilt / 2), math.sin(tilt / 2), 0.0, 0.0])  # roll right side down
-    state = resting_state([0.0, 0.0, 50.0], SETTINGS, q)
-    after = _fly(body, state, state[THRUSTS] / SETTINGS.rotor_thrust_max_n, 40)  # 20 s, 13 m/k
-    terminal = SETTINGS.mass_kg * G * math.tan(tilt) / SETTINGS.drag_n_per_m_s
-    assert after[VELOCITY] == pytest.approx([0.0, -terminal, 0.0], abs=1e-5)
-    assert after[ATTITUDE] == pytest.approx(q, abs=1e-9)  # equal thrusts: no moment
-
-
-def test_a_wind_is_felt_through_the_drag(body):
-    state = resting_state([0.0, 0.0, 50.0], SETTINGS)
-    after = _fly(
-        body, state, state[THRUSTS] / SETTINGS.rotor_thrust_max_n, 40, np.array([3.0, 0, 0])
-    )
-    assert after[VELOCITY] == pytest.approx(
-        [3.0, 0.0, 0.0], abs=1e-5
-    )  # carried at the wind's speed
+def test_a_wind_carries_a_body_whose_drag_does_not_pitch_it():
+    # rotors in the centre of mass' plane: the rotors' drag makes no moment, the body stays
+    # level and is carried at the wind's speed (time constant m / (4 k_d omega) ~ 4 s)
+    flat = replace(SETTINGS, rotor_height_m=0.0)
+    body = RigidBody(flat, STEP_S)
+    state = resting_state([0.0, 0.0, 50.0], flat)
+    after = _fly(body, state, state[THRUSTS] / flat.rotor_thrust_max_n, 100, np.array([3.0, 0, 0]))
+    assert after[VELOCITY] == pytest.approx([3.0, 0.0, 0.0], abs=1e-4)
+    assert after[ATTITUDE] == pytest.approx([1.0, 0.0, 0.0, 0.0], abs=1e-12)
 
 
 @pytest.mark.parametrize(
