@@ -226,3 +226,34 @@ def test_a_wind_set_live_pushes_a_multicopter_and_not_a_kinematic_point(along_wo
     assert drift(flying, None) == pytest.approx(0.0, abs=1e-6)  # still air: it stays
     assert drift(flying, 6.0) < -0.05  # blown west before the autopilot catches it
     assert drift(along_world, 6.0) == 0.0  # a kinematic point feels no wind
+
+
+def test_a_px4_speed_limit_set_live_slows_a_multicopter(along_world):
+    from dataclasses import replace
+
+    from mission.world.model import World
+
+    flying = World(
+        replace(
+            along_world.scenario,
+            vehicle=replace(along_world.scenario.vehicle, dynamics="multicopter", radius_m=None),
+        )
+    )
+    home = np.array([0.0, 12.0, 6.0])
+
+    def speed_after_1_5_s(limit_m_s: float | None) -> float:
+        vehicle = _vehicle(flying, home)
+        vehicle.change_mode(modes.GUIDED)
+        vehicle.arm(True)
+        if limit_m_s is not None:
+            _set(vehicle, "MPC_XY_VEL_MAX", limit_m_s)
+        vehicle.kinematics.target = home + [10.0, 0.0, 0.0]
+        for _ in range(3):
+            vehicle.step()
+        return float(np.linalg.norm(vehicle.kinematics.velocity[:2]))
+
+    assert speed_after_1_5_s(None) > 0.8  # toward the guidance's limit
+    assert 0.4 < speed_after_1_5_s(0.5) <= 0.5  # most of the limit, and no more
+    refused = _vehicle(flying, home)
+    _set(refused, "MPC_TILTMAX_AIR", 95.0)  # out of range: refused, the loops untouched
+    assert refused.params.table.value("MPC_TILTMAX_AIR") == 45.0
