@@ -255,5 +255,7 @@ def test_a_px4_speed_limit_set_live_slows_a_multicopter(along_world):
     assert speed_after_1_5_s(None) > 0.8  # toward the guidance's limit
     assert 0.4 < speed_after_1_5_s(0.5) <= 0.5  # most of the limit, and no more
     refused = _vehicle(flying, home)
-    _set(refused, "MPC_TILTMAX_AIR", 95.0)  # out of range: refused, the loops untouched
-    assert refused.params.table.value("MPC_TILTMAX_AIR") == 45.0
+    kind = mavlink2.MAV_PARAM_TYPE_REAL32
+    refused.params.handle(mavlink2.MAVLink_param_set_message(2, 1, b"MPC_TILTMAX_AIR", 95.0, kind))
+    assert refused.params.table.value("MPC_TILTMAX_AIR") == 45.0  # out of range: refused
+    assert refused.kinematics.settings.tilt_max_deg == 45.0  # and the loops untouched
