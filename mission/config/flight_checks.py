@@ -4,7 +4,7 @@ every vehicle dying at its first step.
 
 - The integration step h = 1 / ``rate_hz`` (at most :data:`MAX_RATE_HZ`: a step of substeps
   is computed whole) is at most half of the body's fastest time constants: the motors' lag,
-  mass over the rotors' drag at full thrust, the least moment of inertia over the rotational
+  mass over the rotors' drag at hover, the least moment of inertia over the rotational
   damping (a classical
   Runge-Kutta step is stable to |lambda h| ~ 2.8; two steps a time constant keeps it accurate).
 - The rate loop, a gain K on the rate error through the motors' first-order lag tau, is the
@@ -43,21 +43,12 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
         "multicopter.rate_hz",
         f"must be at most {MAX_RATE_HZ:g} Hz, got {body.rate_hz:g}",
     )
-    hover = body.mass_kg * STANDARD_GRAVITY / 4
-    require(
-        body.rotor_thrust_max_n <= MAX_THRUST_TO_WEIGHT * hover,
-        "multicopter.rotor_thrust_max_n",
-        f"must be at most {MAX_THRUST_TO_WEIGHT:g} times a quarter of the weight "
-        f"({hover:.2f} N; a racing quadrotor's thrust-to-weight)",
-    )
     h = 1.0 / body.rate_hz
     constants = [("motor_tau_s", "the motors' lag", body.motor_tau_s)]
-    full_speed = math.sqrt(body.rotor_thrust_max_n / body.rotor_thrust_coefficient)
-    drag = 4 * full_speed * body.rotor_drag_coefficient
+    hover_speed = math.sqrt(body.mass_kg * STANDARD_GRAVITY / 4 / body.rotor_thrust_coefficient)
+    drag = 4 * hover_speed * body.rotor_drag_coefficient
     if drag > 0:
-        constants.append(
-            ("rotor_drag_coefficient", "mass over the rotors' drag", body.mass_kg / drag)
-        )
+        constants.append(("mass_kg", "mass over the rotors' drag", body.mass_kg / drag))
     if body.rotational_damping_n_m_per_rad_s > 0:
         least = min(body.inertia_kg_m2) / body.rotational_damping_n_m_per_rad_s
         constants.append(("inertia_kg_m2", "inertia over rotational damping", least))
@@ -84,12 +75,7 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
         f"(at least {MIN_RATE_LOOP_DAMPING:g}: K tau at most "
         f"{1 / (4 * MIN_RATE_LOOP_DAMPING**2):g})",
     )
-    require(
-        body.rotor_torque_max_n_m <= body.rotor_thrust_max_n * body.lever_m,
-        "multicopter.rotor_torque_max_n_m",
-        "must be at most rotor_thrust_max_n x lever_m (a propeller's drag torque is a few per "
-        "cent of its thrust's moment)",
-    )
+    _check_rotors(body)
     cascade = ("position", "velocity", "attitude", "rate")
     for outer, inner in itertools.pairwise(cascade):
         least = MIN_POSITION_RATIO if outer == "position" else MIN_CASCADE_RATIO
@@ -101,3 +87,20 @@ def check_flyable(body: MulticopterSettings, loops: AutopilotSettings) -> None:
             f"{slow:g} must be below {inner}_gain_per_s ({fast:g}) by a factor of at least "
             f"{least:g}: a loop too close to the one it commands couples with it",
         )
+
+
+def _check_rotors(body: MulticopterSettings) -> None:
+    """The rotors' thrust and torque within what a quadrotor has."""
+    hover = body.mass_kg * STANDARD_GRAVITY / 4
+    require(
+        body.rotor_thrust_max_n <= MAX_THRUST_TO_WEIGHT * hover,
+        "multicopter.rotor_thrust_max_n",
+        f"must be at most {MAX_THRUST_TO_WEIGHT:g} times a quarter of the weight "
+        f"({hover:.2f} N; a racing quadrotor's thrust-to-weight)",
+    )
+    require(
+        body.rotor_torque_max_n_m <= body.rotor_thrust_max_n * body.lever_m,
+        "multicopter.rotor_torque_max_n_m",
+        "must be at most rotor_thrust_max_n x lever_m (a propeller's drag torque is a few per "
+        "cent of its thrust's moment)",
+    )

@@ -14,8 +14,9 @@ The air's forces are RotorPy's (spencerfolk/rotorpy, ``rotorpy/vehicles/multirot
 its AscTec Hummingbird's constants (``hummingbird_params.py``): each rotor's drag
 -omega k_d v_air in the rotor's plane at its hub, omega = sqrt(T / k_eta) the rotor's speed,
 and the frame's parasitic drag -|v_air| diag(c_Dx, c_Dy, c_Dz) v_air at the centre of mass,
-both in the body frame. RotorPy's inflow term along the rotor's axis (k_z) and translational
-lift (k_h), which nearly cancel in forward flight, are left out. SIH's linear KDV drag is not used (SIH feels no wind).
+both in the body frame. RotorPy's inflow term along the rotor's axis (k_z) and its
+translational lift (k_h) are left out: the rotors' drag acts in their plane only. SIH's
+linear KDV drag is not used (SIH feels no wind).
 
 Near a surface a rotor makes more thrust for the same power (:data:`PROXIMITY_MODELS`):
 ``measured`` is the ceiling law of Hsiao and Chirarattananon (2019) and the multirotor ground

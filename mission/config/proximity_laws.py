@@ -23,21 +23,32 @@ Every law holds its value at ``proximity_clip_radii`` rotor radii closer in.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
-if TYPE_CHECKING:
-    from mission.config.multicopter_settings import MulticopterSettings
+
+class RotorLayout(Protocol):
+    """What the laws read of a multicopter's settings."""
+
+    rotor_radius_m: float
+    proximity_clip_radii: float
+    ceiling_model: str
+    ground_model: str
+    lever_m: float
+
+    @property
+    def rotor_arm_m(self) -> float: ...
+
 
 CEILING_A0, CEILING_A1 = 1.6, 0.0  # Hsiao and Chirarattananon (2019)
 GROUND_BODY_LIFT = 2.0  # Sanchez-Cuevas et al. (2017)'s K_b
 
 
-def _held(body: MulticopterSettings, distance_m: Any, maximum: Any) -> Any:
+def _held(body: RotorLayout, distance_m: Any, maximum: Any) -> Any:
     """``distance_m`` no closer than the clip (``maximum``: fmax for the type at hand)."""
     return maximum(distance_m, body.proximity_clip_radii * body.rotor_radius_m)
 
 
-def ceiling_gain(body: MulticopterSettings, distance_m: Any, maximum: Any = max) -> Any:
+def ceiling_gain(body: RotorLayout, distance_m: Any, maximum: Any = max) -> Any:
     """T/T0 of a rotor ``distance_m`` below a surface, by ``body.ceiling_model``."""
     d = _held(body, distance_m, maximum)
     delta2 = (body.rotor_radius_m / d) ** 2
@@ -50,7 +61,7 @@ def ceiling_gain(body: MulticopterSettings, distance_m: Any, maximum: Any = max)
     return 1.0 + 0 * d
 
 
-def ground_gain_denominator(body: MulticopterSettings, height_m: Any) -> Any:
+def ground_gain_denominator(body: RotorLayout, height_m: Any) -> Any:
     """The ground law's denominator at ``height_m`` (the gain is its inverse)."""
     r, z = body.rotor_radius_m, height_m
     images = 1 - (r / (4 * z)) ** 2
@@ -62,7 +73,7 @@ def ground_gain_denominator(body: MulticopterSettings, height_m: Any) -> Any:
     return images - 2 * r**2 * z * GROUND_BODY_LIFT / (far**2 + 4 * z**2) ** 1.5
 
 
-def ground_gain(body: MulticopterSettings, height_m: Any, maximum: Any = max) -> Any:
+def ground_gain(body: RotorLayout, height_m: Any, maximum: Any = max) -> Any:
     """T/T0 of a rotor ``height_m`` above a surface, by ``body.ground_model``."""
     z = _held(body, height_m, maximum)
     if body.ground_model == "none":
