@@ -9,7 +9,9 @@ historical (docs/development.md). Between them the runs exercise the defaults' w
 points in Along; a flying quadrotor in gusty wind with dynamic roles, routes and the work
 UAV's own fix in piers; and the integrity monitor excluding and restoring a glitched support
 in Along: 40 simulated seconds each, about 3, 6 and 3 s of wall time. A study made before a
-run joined the canary is compared on the runs both have.
+run joined the canary is compared on the runs both have; a canary run that flies quadrotors
+speaks only for studies that fly them (:func:`flies_quadrotors`): a study of kinematic points
+is not made stale by a change to the quadrotors' model.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mission.studies.runkeys import StudyRun, keyed_run, resolved_key
-from mission.studies.spec import Point
+from mission.studies.spec import Point, StudySpec, validate_points
 
 CANARY_S = 40.0  # simulated seconds of each canary run
 
@@ -107,12 +109,25 @@ def canary_record(summaries: list[dict[str, Any] | None]) -> dict[str, Any]:
     }
 
 
-def canary_differences(theirs: dict[str, Any] | None, today: dict[str, Any]) -> list[str] | None:
+QUADROTORS = ("vehicle.dynamics", "multicopter")
+
+
+def flies_quadrotors(spec: StudySpec) -> bool:
+    """Whether any of the study's runs flies quadrotors (``vehicle.dynamics: multicopter``)."""
+    return any(s.vehicle.dynamics == "multicopter" for s in validate_points(spec).values())
+
+
+def canary_differences(
+    theirs: dict[str, Any] | None, today: dict[str, Any], quadrotors: bool = True
+) -> list[str] | None:
     """The canary runs whose digests differ between a study's canary and today's, over the
-    runs both name (None where they share none, or either has no digest for one)."""
+    runs both name (None where they share none, or either has no digest for one);
+    ``quadrotors`` False: a study that flies none, for which the runs that fly them do not
+    speak."""
     mine = {r["run"]: r.get("decisions_digest") for r in today.get("runs", [])}
     old = {r["run"]: r.get("decisions_digest") for r in (theirs or {}).get("runs", [])}
-    shared = [run for run in old if run in mine]
+    flying = {c.label for c in CANARY if QUADROTORS in c.overrides}
+    shared = [run for run in old if run in mine and (quadrotors or run not in flying)]
     if not shared or any(old[run] is None or mine[run] is None for run in shared):
         return None
     return [run for run in shared if old[run] != mine[run]]

@@ -17,7 +17,12 @@ from typing import Any, TextIO
 
 from mission.config.errors import InputError
 from mission.procs.atomic import write_text_atomically
-from mission.studies.canary import canary_differences, canary_record, canary_runs
+from mission.studies.canary import (
+    canary_differences,
+    canary_record,
+    canary_runs,
+    flies_quadrotors,
+)
 from mission.studies.provenance_file import read_provenance
 from mission.studies.results import read_results_csv, result_row, results_csv
 from mission.studies.runkeys import StudyRun, code_version
@@ -119,16 +124,18 @@ def run_label(run: StudyRun) -> str:
     return f"{run.scenario_name}{point} {run.method.upper()} seed {run.seed}"
 
 
-def canary_verdict(committed: dict[str, Any] | None, summaries: list[dict | None]) -> str:
+def canary_verdict(
+    committed: dict[str, Any] | None, summaries: list[dict | None], quadrotors: bool = True
+) -> str:
     """What --verify says once the canary is made: the study's canary against today's, run by
-    run over the runs both have."""
+    run over the runs both have (those that fly quadrotors only if ``quadrotors``)."""
     today = canary_record(summaries)
     if today["digest"] is None:
         return "canary: FAILED to run; today's decisions are unknown"
     if not committed:
         return f"canary: {today['digest']}; the study has no provenance.json to compare it with"
     commit = str(committed.get("commit") or "an unknown commit")[:12]
-    differing = canary_differences(committed.get("canary"), today)
+    differing = canary_differences(committed.get("canary"), today, quadrotors)
     if differing is None:
         return f"canary: {today['digest']}; the study's canary (commit {commit}) shares no run"
     if not differing:
@@ -208,7 +215,8 @@ def run_verify(
 
     def canary_made() -> None:
         if not verdict and all(run in summaries for run in canaries):
-            verdict.append(canary_verdict(committed, [summaries[run] for run in canaries]))
+            made = [summaries[run] for run in canaries]
+            verdict.append(canary_verdict(committed, made, flies_quadrotors(spec)))
             progress.write(verdict[0] + "\n")  # at once, before the rows finish
 
     def done(run: StudyRun, summary: dict | None, wall: float) -> None:

@@ -179,3 +179,20 @@ def test_a_study_made_before_a_canary_run_joined_is_compared_on_the_runs_it_has(
     (study / "provenance.json").write_text(json.dumps(provenance))
     outcome, progress = _verify(study, tmp_path, count=1)
     assert outcome.agrees and "as when the study was made" in progress.splitlines()[1]
+
+
+def test_a_canary_run_that_flies_quadrotors_speaks_only_for_studies_that_fly_them():
+    from pathlib import Path
+
+    from mission.studies.canary import canary_differences, flies_quadrotors
+    from mission.studies.spec import load_study, shipped_study
+
+    labels = [c.label for c in CANARY]
+    then = {"runs": [{"run": label, "decisions_digest": "a"} for label in labels]}
+    today = {"runs": [{"run": label, "decisions_digest": "a"} for label in labels]}
+    today["runs"][1]["decisions_digest"] = "b"  # the piers run, with quadrotors, moved
+    assert "multicopter" in labels[1]
+    assert canary_differences(then, today) == [labels[1]]
+    assert canary_differences(then, today, quadrotors=False) == []
+    assert flies_quadrotors(load_study(shipped_study(Path("dynamics"))))
+    assert not flies_quadrotors(load_study(shipped_study(Path("table3"))))

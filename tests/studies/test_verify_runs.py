@@ -8,11 +8,17 @@ from pathlib import Path
 
 import pytest
 
-from mission.studies.canary import canary_differences, canary_record, canary_runs
+from mission.studies.canary import (
+    canary_differences,
+    canary_record,
+    canary_runs,
+    flies_quadrotors,
+)
 from mission.studies.local_engine import LocalEngine
 from mission.studies.provenance_file import read_provenance
 from mission.studies.results import read_results_csv
 from mission.studies.runkeys import code_version
+from mission.studies.spec import load_study, shipped_study
 from tests.processes import ROOT, mission
 
 pytestmark = pytest.mark.slow  # every test here starts runs
@@ -41,7 +47,9 @@ def test_every_committed_study_gives_todays_canary_or_is_marked_historical(canar
         provenance = read_provenance(folder)
         if provenance is None or provenance.get("historical"):
             continue  # test_committed: each has one (and historical ones say why)
-        differing = canary_differences(provenance.get("canary"), today)
+        spec = shipped_study(Path(folder.name))
+        quadrotors = spec is None or flies_quadrotors(load_study(spec))
+        differing = canary_differences(provenance.get("canary"), today, quadrotors)
         if differing != []:
             commit = str(provenance.get("commit"))[:12]
             stale.append(f"{folder.name} (made with {commit}: {differing or 'no shared run'})")
