@@ -237,7 +237,8 @@ class GroundStation:
             links.queue_for(vision_position_estimate(state.xhat, self.clock.time_usec), work)
         self._announce_sight(state, decision.blind)
         time_ms = round(self.clock.time_s * 1000)
-        links.queue_for(position_target(decision.work_command, time_ms, work.system_id), work)
+        setpoint = self._setpoint(state.xhat, decision.work_command, time_ms, work.system_id)
+        links.queue_for(setpoint, work)
         if decision.arrived is not None and not state.completed:
             links.queue_for(mission_set_current(work.system_id, state.k + 1), work)
             links.announce(f"Work UAV reached waypoint {decision.arrived + 1}")
@@ -261,7 +262,19 @@ class GroundStation:
             view = self.links.views[name]
             estimate = vision_position_estimate(state.yhat[name], self.clock.time_usec)
             self.links.queue_for(estimate, view)
-            self.links.queue_for(position_target(target, time_ms, view.system_id), view)
+            setpoint = self._setpoint(state.yhat[name], target, time_ms, view.system_id)
+            self.links.queue_for(setpoint, view)
+
+    def _setpoint(self, start: np.ndarray, command: np.ndarray, time_ms: int, system_id: int):
+        """A UAV's SET_POSITION_TARGET_LOCAL_NED for a plan from ``start`` whose first point
+        is ``command``: that point (a kinematic vehicle's interface), or, for a flying
+        quadrotor with ``control.velocity_feedforward``, ``start`` and the plan's velocity
+        (the target moves on at it, and the autopilot feeds it forward)."""
+        scenario = self.context.scenario
+        if scenario.vehicle.dynamics != "multicopter" or not scenario.control.velocity_feedforward:
+            return position_target(command, time_ms, system_id)
+        velocity = (np.asarray(command) - np.asarray(start)) / scenario.control.t_pred_s
+        return position_target(start, time_ms, system_id, velocity)
 
     def _ages_ms(self, reports: list[SupportReport]) -> dict[str, list[float | None]] | None:
         """Real time: each support's [GNSS fix, camera observation] age in ms (None: not

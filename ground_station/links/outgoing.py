@@ -11,6 +11,7 @@ from mission.world.frames import enu_to_ned
 GCS_SYSTEM_ID = 255
 GCS_COMPONENT_ID = 190
 POSITION_ONLY = 0b0000_1101_1111_1000  # SET_POSITION_TARGET type_mask: position, no yaw
+POSITION_VELOCITY = 0b0000_1101_1100_0000  # ... position and velocity, no yaw
 GUIDED_AND_ARMED = (  # DO_SET_MODE custom mode 4 (GUIDED), then arm
     (mavlink2.MAV_CMD_DO_SET_MODE, (1, 4)),
     (mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, (1,)),
@@ -39,20 +40,28 @@ def vision_position_estimate(
 
 
 def position_target(
-    target_enu: np.ndarray, time_boot_ms: int, system_id: int
+    target_enu: np.ndarray,
+    time_boot_ms: int,
+    system_id: int,
+    velocity_enu: np.ndarray | None = None,
 ) -> mavlink2.MAVLink_set_position_target_local_ned_message:
-    """A position-only SET_POSITION_TARGET_LOCAL_NED (LOCAL_NED, origin at the anchor)."""
+    """A SET_POSITION_TARGET_LOCAL_NED (LOCAL_NED, origin at the anchor): a position, or a
+    position and the velocity it moves on at (the autopilot's feed-forward)."""
     n, e, d = (float(v) for v in enu_to_ned(target_enu))
+    mask, velocity = POSITION_ONLY, [0.0, 0.0, 0.0]
+    if velocity_enu is not None:
+        mask, velocity = POSITION_VELOCITY, [float(v) for v in enu_to_ned(velocity_enu)]
     return mavlink2.MAVLink_set_position_target_local_ned_message(
         time_boot_ms,
         system_id,
         1,
         mavlink2.MAV_FRAME_LOCAL_NED,
-        POSITION_ONLY,
+        mask,
         n,
         e,
         d,
-        *[0] * 8,
+        *velocity,
+        *[0] * 5,
     )
 
 

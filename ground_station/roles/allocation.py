@@ -239,11 +239,11 @@ def _routed(state: StationState, context: RoleContext, name: str, goal: np.ndarr
 
 def _crowding_m(context: RoleContext) -> float:
     """How close to another UAV's estimate a routed support does not go: the separation
-    widened by two estimates' allowance (0: no separation margin)."""
+    widened by two vehicles' allowance (0: no separation margin)."""
     control = context.scenario.control
     if control.min_separation_m <= 0:
         return 0.0
-    return control.min_separation_m + 2 * control.estimate_allowance_m
+    return control.min_separation_m + 2 * control.allowance_m
 
 
 def routed_plans(state: StationState, context: RoleContext, allocation: Allocation):

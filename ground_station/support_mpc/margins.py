@@ -1,8 +1,9 @@
 """The safety margins of a support's MPC as linear constraints: every predicted step at least
 ``control.min_separation_m`` from each other UAV's predicted position at that step, and at
 least ``control.clearance_m`` from the structure and the ground, each widened by
-``control.estimate_allowance_m`` per estimate involved (two between UAVs, one for clearance),
-so that the margins hold for the true positions and not only for the estimates.
+``control.estimate_allowance_m`` and ``control.tracking_allowance_m`` per vehicle involved (two
+between UAVs, one for clearance), so that the margins hold for the true positions and not only
+for the estimates, and for a vehicle that lags its plan.
 
 Both are linearised at the solve's guess (the previous plan, shifted) as separating
 half-spaces (:mod:`mission.world.proximity`): from another UAV at o, n.v >= n.o + d with n the
@@ -40,7 +41,7 @@ class Margins:
     def __init__(
         self, control: ControlSettings, structure: Structure, others: int, compiled: bool = True
     ) -> None:
-        allowance = control.estimate_allowance_m  # the plans are made on estimates
+        allowance = control.allowance_m  # the plans are made on estimates, flown with a lag
         self.separation = control.min_separation_m
         self.clearance = control.clearance_m
         if self.separation > 0:

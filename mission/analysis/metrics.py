@@ -57,6 +57,8 @@ _WANTED_IDS = frozenset(
     }
 )
 
+VELOCITY_IGNORED = 0b0000_0000_0011_1000  # SET_POSITION_TARGET's velocity bits, all set
+
 
 def read_tlog(tlog: Path, scenario: Scenario) -> RunTrace:
     """Truth (SIM_STATE), the work UAV's estimates, clock ticks and completion from a tlog."""
@@ -117,14 +119,7 @@ def trace_of_messages(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         elif kind == "VISION_POSITION_ESTIMATE":
             pending_estimate = (t, ned_to_enu(np.array([message.x, message.y, message.z])))
         elif kind == "SET_POSITION_TARGET_LOCAL_NED":
-            target = message.target_system
-            trace.setpoints[(target, t)] = ned_to_enu(np.array([message.x, message.y, message.z]))
-            if pending_estimate is not None:
-                trace.sent_estimates[(target, t)] = pending_estimate[1]
-            if target == 1:
-                trace.cycles.add(t)
-                if pending_estimate is not None:
-                    trace.estimates[pending_estimate[0]] = pending_estimate[1]
+            _note_setpoint(trace, message, t, pending_estimate)
             pending_estimate = None
         elif kind == "SYSTEM_TIME" and message.time_boot_ms > 0:
             trace.ticks.add(round(message.time_boot_ms / 1000.0, 3))
@@ -139,6 +134,24 @@ def trace_of_messages(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
             if trace.ticks or system in offsets:
                 into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
     return trace
+
+
+def _note_setpoint(
+    trace: RunTrace, message: Any, t: float, estimate: tuple[float, np.ndarray] | None
+) -> None:
+    """A setpoint the ground station sent at ``t``, after ``estimate`` (None: none): the
+    target, its velocity where it has one, and for the work UAV a cycle."""
+    target = message.target_system
+    trace.setpoints[(target, t)] = ned_to_enu(np.array([message.x, message.y, message.z]))
+    if not message.type_mask & VELOCITY_IGNORED:
+        velocity = np.array([message.vx, message.vy, message.vz])
+        trace.setpoint_velocities[(target, t)] = ned_to_enu(velocity)
+    if estimate is not None:
+        trace.sent_estimates[(target, t)] = estimate[1]
+    if target == 1:
+        trace.cycles.add(t)
+        if estimate is not None:
+            trace.estimates[estimate[0]] = estimate[1]
 
 
 class _VehicleTexts:

@@ -21,6 +21,8 @@ class RunTrace:
     beliefs: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     fixes: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)  # 3-D GNSS fixes
     setpoints: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    # the velocity a setpoint moves on at, where it has one (a flying vehicle's feed-forward)
+    setpoint_velocities: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     sent_estimates: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     cycles: set[float] = field(default_factory=set)  # times of the work UAV's setpoints
     ticks: set[float] = field(default_factory=set)

@@ -3,13 +3,15 @@
 A vehicle is sent a position setpoint (SET_POSITION_TARGET_LOCAL_NED) each control cycle,
 after the estimate that resets what it believes (VISION_POSITION_ESTIMATE; a blind work UAV
 gets none and goes on with its own belief). Over the cycle an ideal vehicle - the kinematic
-point of :mod:`vehicle_sim.dynamics.kinematics` - would move from its belief toward the setpoint by
-at most its speed limit times the cycle. The **tracking error** of a cycle is the distance
-between where the vehicle then believes it is (LOCAL_POSITION_NED at the next cycle's time,
-before that cycle's estimate) and where the ideal vehicle would be. It is measured in the
-frame the autopilot steers in (its belief), so it is the control loop's lag and overshoot,
-not the estimate's error (the work UAV's error is ``work_error_m``); a kinematic point
-without tracking noise scores 0 up to the messages' float32 rounding.
+point of :mod:`vehicle_sim.dynamics.kinematics` - would move from its belief toward the
+setpoint by at most its speed limit times the cycle; toward a setpoint with a velocity (a
+flying vehicle's feed-forward), as far as the setpoint moves at that velocity. The
+**tracking error** of a cycle is the distance between where the vehicle then believes it is
+(LOCAL_POSITION_NED at the next cycle's time, before that cycle's estimate) and where the
+ideal vehicle would be. It is measured in the frame the autopilot steers in (its belief), so
+it is the control loop's lag and overshoot, not the estimate's error (the work UAV's error is
+``work_error_m``); a kinematic point without tracking noise scores 0 up to the messages'
+float32 rounding.
 
 Exact in lockstep (every belief sample falls on a cycle's time); in real time the beliefs
 are interpolated to the cycles' times, which can mix in an estimate's jump.
@@ -43,7 +45,11 @@ def tracking_errors(trace: RunTrace, speed_m_s: float, system: int) -> np.ndarra
             start = held[k] if known[k] else None
         if start is None or not known[k + 1]:
             continue
-        wanted = trace.setpoints[(system, start_time)] - start
+        key = (system, start_time)
+        velocity = trace.setpoint_velocities.get(key)
+        wanted = trace.setpoints[key] - start
+        if velocity is not None:
+            wanted = wanted + velocity * (end_time - start_time)
         distance = float(np.linalg.norm(wanted))
         reach = speed_m_s * (end_time - start_time)
         ideal = start + (wanted if distance <= reach else wanted * (reach / distance))

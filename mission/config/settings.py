@@ -7,7 +7,7 @@ defaults); field names carry their units (``_m``, ``_s``, ``_deg``, ``_hz``, ``_
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import datetime
 from typing import Literal
 
@@ -215,6 +215,16 @@ class MapSettings:
 
 
 MAX_WEIGHT = 1e6
+# a flying quadrotor's tracking error with the velocity feed-forward, p95 over a run's cycles
+# (docs/model.md, "A ground station that knows the lag"); a kinematic point tracks exactly
+FLYING_TRACKING_ALLOWANCE_M = 0.3
+
+
+def tracking_allowance(dynamics: str) -> float:
+    """The default tracking allowance for vehicles of ``dynamics``."""
+    return FLYING_TRACKING_ALLOWANCE_M if dynamics == "multicopter" else 0.0
+
+
 MAX_T_PRED_S = 10.0
 
 
@@ -240,10 +250,15 @@ class ControlSettings:
     min_separation_m: float  # between any two UAVs over the MPCs' horizon (0: no margin)
     clearance_m: float  # from the structure and the ground over the horizon (0: no margin)
     estimate_allowance_m: float  # the MPCs keep margins this much wider per estimate involved
+    tracking_allowance_m: float | None  # ... and this much per vehicle for its tracking error
+    # (None in a scenario: the default for the vehicles' dynamics, set by the Scenario)
+    velocity_feedforward: bool  # flying vehicles get the plan's velocity with its position
 
     def __post_init__(self) -> None:
         _require(self.horizon_steps >= 1, "horizon_steps", "must be at least 1")
         _non_negative(self, "min_separation_m", "clearance_m", "estimate_allowance_m")
+        if self.tracking_allowance_m is not None:
+            _non_negative(self, "tracking_allowance_m")
         _positive(self, "t_pred_s", "t_cont_s", "s_max_work_m_s", "s_max_support_m_s")
         _positive(self, "arrival_tol_m", "support_max_sigma0_m")
         _non_negative(self, "w_gnss", "w_interval", "w_waypoint", "w_relative", "w_penalty")
@@ -252,6 +267,12 @@ class ControlSettings:
         _at_most(self, MAX_T_PRED_S, "a prediction step of at most 10 s", "t_pred_s")
         for name in ("s_max_work_m_s", "s_max_support_m_s"):
             _as_parameter(name, 100 * getattr(self, name), "WPNAV_SPEED", " cm/s")
+
+    @property
+    def allowance_m(self) -> float:
+        """How much wider the margins are kept per vehicle involved: its estimate's error and
+        its tracking error."""
+        return self.estimate_allowance_m + (self.tracking_allowance_m or 0.0)
 
     @property
     def d_max_work_m(self) -> float:
@@ -329,6 +350,11 @@ class Scenario:
     integrity: IntegritySettings
 
     def __post_init__(self) -> None:
+        if self.control.tracking_allowance_m is None:  # frozen: set once, as left to the default
+            allowance = tracking_allowance(self.vehicle.dynamics)
+            object.__setattr__(
+                self, "control", replace(self.control, tracking_allowance_m=allowance)
+            )
         self._check_margins()
         self._check_integrity()
         check_faults(self.faults, self.task.supports, self.run.timeout_s, self.control.t_cont_s)

@@ -230,6 +230,6 @@ def route_map(world: KnownWorld, sigma0: np.ndarray | None = None) -> RouteMap:
     return RouteMap(
         world.map_grid(),
         StructureProximity(world.structure),
-        margin + control.estimate_allowance_m + ROUTE_EXTRA_M,
+        margin + control.allowance_m + ROUTE_EXTRA_M,
         np.clip((np.asarray(sigma0) / good) ** 2, 1.0, POOR_GNSS_COST),
     )

@@ -162,13 +162,14 @@ def test_a_changed_cell_is_listed_and_fails_but_a_timing_is_not_compared(made, t
 def test_a_stale_canary_is_said_at_once_with_the_commit(made, tmp_path):
     study, _ = made
     provenance = read_provenance(study)
-    provenance["canary"]["runs"][1]["decisions_digest"] = "0" * 16
+    runs = provenance["canary"]["runs"]
+    runs[2]["decisions_digest"] = "0" * 16  # the integrity run (the study flies no quadrotors)
     (study / "provenance.json").write_text(json.dumps(provenance))
     outcome, progress = _verify(study, tmp_path, count=1)
     assert not outcome.agrees
     said = progress.splitlines()[1]
     assert said.startswith("canary: STALE") and provenance["commit"][:12] in said
-    assert provenance["canary"]["runs"][1]["run"] in said and "along AC" not in said
+    assert runs[2]["run"] in said and runs[0]["run"] not in said and runs[1]["run"] not in said
 
 
 def test_a_study_made_before_a_canary_run_joined_is_compared_on_the_runs_it_has(made, tmp_path):

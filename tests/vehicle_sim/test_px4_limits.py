@@ -103,7 +103,8 @@ def test_the_tilt_reaches_its_limit_before_the_speed_does(loop):
 
 def _commands_function():
     state, controller = ca.SX.sym("x", STATE_SIZE), ca.SX.sym("c", CONTROLLER_SIZE)
-    inputs = [ca.SX.sym(n, k) for n, k in (("t", 3), ("d", 3), ("s", 1), ("k", len(TUNED_FIELDS)))]
+    sizes = (("t", 3), ("d", 3), ("s", 1), ("k", len(TUNED_FIELDS)), ("v", 3))
+    inputs = [ca.SX.sym(n, k) for n, k in sizes]
     commands, _ = motor_commands(BODY, LOOPS, state, controller, tuple(inputs))
     return ca.Function("commands", [state, controller, *inputs], [commands])
 
@@ -114,7 +115,9 @@ def test_a_20_m_move_at_full_speed_keeps_every_rotor_within_its_range_and_the_at
     state, target, tuning = _start(), HOME + [20.0, 0.0, 0.0], np.array(LOOPS.tuning())
     least, most, tilts = 1.0, 0.0, []
     for _ in range(round(15.0 * BODY.rate_hz)):
-        wanted = commands(state[:STATE_SIZE], state[STATE_SIZE:], target, np.zeros(3), 12.0, tuning)
+        wanted = commands(
+            state[:STATE_SIZE], state[STATE_SIZE:], target, np.zeros(3), 12.0, tuning, np.zeros(3)
+        )
         least, most = min(least, float(ca.mmin(wanted))), max(most, float(ca.mmax(wanted)))
         state, _ = every_substep.advance(state, target, np.zeros(3), 12.0, np.zeros(3))
         tilts.append(_tilt_deg(state[ATTITUDE]))

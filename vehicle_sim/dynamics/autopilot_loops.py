@@ -1,9 +1,10 @@
 """The autopilot's position controller for the rigid body (docs/model.md, "A multicopter's
 dynamics"), as casadi expressions run at the integration rate: PX4's multicopter cascade.
 
-1. position error (from where the autopilot *believes* it is) -> velocity setpoint: PX4's
-   MPC_XY_P and MPC_Z_P, the horizontal speed capped by norm at the lower of the guidance's
-   limit and MPC_XY_VEL_MAX, the vertical at MPC_Z_VEL_MAX_UP / _DN;
+1. position error (from where the autopilot *believes* it is) -> velocity setpoint: the
+   setpoint's velocity feed-forward plus PX4's MPC_XY_P and MPC_Z_P times the error, the
+   horizontal capped by norm at the lower of the guidance's limit and MPC_XY_VEL_MAX (the
+   error's share kept first, PX4's ``constrainXY``), the vertical at MPC_Z_VEL_MAX_UP / _DN;
 2. velocity error -> acceleration -> thrust vector: PX4's PID with its tilt and thrust limits
    and anti-windup (:mod:`~vehicle_sim.dynamics.px4_thrust`); the derivative acts on the
    velocity's rate of change, low-passed at MPC_VELD_LP (a filter state);
@@ -46,16 +47,33 @@ def _tuned(tuning: ca.SX) -> dict[str, ca.SX]:
     return {name: tuning[i] for i, name in enumerate(TUNED_FIELDS)}
 
 
-def velocity_setpoint(
-    tune: dict[str, ca.SX], believed: ca.SX, target: ca.SX, speed_limit: ca.SX
-) -> ca.SX:
-    """PX4's position loop: the velocity wanted, each direction within its limits."""
-    error = target - believed
-    horizontal = _capped(
-        tune["position_gain_per_s"] * error[:2],
-        ca.fmin(speed_limit, tune["horizontal_speed_max_m_s"]),
+def constrain_xy(first: ca.SX, then: ca.SX, limit: ca.SX) -> ca.SX:
+    """PX4's ``ControlMath::constrainXY``: ``first + then`` within ``limit`` by norm,
+    ``first`` (the position error's share) kept before ``then`` (the feed-forward)."""
+    both = first + then
+    size_first = ca.norm_2(first)
+    direction = then / (ca.norm_2(then) + TINY)
+    m = ca.dot(direction, first)
+    c = ca.sumsqr(first) - limit**2
+    along = -m + ca.sqrt(ca.fmax(m**2 - c, 0))
+    return ca.if_else(
+        ca.norm_2(both) <= limit,
+        both,
+        ca.if_else(
+            size_first >= limit, first * limit / (size_first + TINY), first + along * direction
+        ),
     )
-    vertical = tune["vertical_position_gain_per_s"] * error[2]
+
+
+def velocity_setpoint(
+    tune: dict[str, ca.SX], believed: ca.SX, target: ca.SX, speed_limit: ca.SX, feedforward: ca.SX
+) -> ca.SX:
+    """PX4's position loop: the feed-forward plus the position error's velocity, each
+    direction within its limits (the error's share first)."""
+    error = target - believed
+    limit = ca.fmin(speed_limit, tune["horizontal_speed_max_m_s"])
+    horizontal = constrain_xy(tune["position_gain_per_s"] * error[:2], feedforward[:2], limit)
+    vertical = feedforward[2] + tune["vertical_position_gain_per_s"] * error[2]
     vertical = ca.fmin(ca.fmax(vertical, -tune["descent_max_m_s"]), tune["climb_max_m_s"])
     return ca.vertcat(horizontal, vertical)
 
@@ -65,16 +83,17 @@ def motor_commands(
     loops: AutopilotSettings,
     state: ca.SX,
     controller: ca.SX,
-    inputs: tuple[ca.SX, ca.SX, ca.SX, ca.SX],
+    inputs: tuple[ca.SX, ca.SX, ca.SX, ca.SX, ca.SX],
 ) -> tuple[ca.SX, ca.SX]:
     """(the rotors' commands, d(controller state)/dt) for this state; ``inputs`` are the
-    position target, the belief's offset from the truth, the guidance's speed limit and the
-    tuning vector."""
-    target, belief_offset, speed_limit, tuning = inputs
+    position target, the belief's offset from the truth, the guidance's speed limit, the
+    tuning vector and the setpoint's velocity feed-forward."""
+    target, belief_offset, speed_limit, tuning, feedforward = inputs
     tune = _tuned(tuning)
     velocity, q, rates = state[VELOCITY], state[ATTITUDE], state[RATES]
     integral, smoothed = controller[:3], controller[3:]
-    wanted = velocity_setpoint(tune, state[POSITION] + belief_offset, target, speed_limit)
+    believed = state[POSITION] + belief_offset
+    wanted = velocity_setpoint(tune, believed, target, speed_limit, feedforward)
     cutoff = 2 * math.pi * loops.velocity_derivative_cutoff_hz
     acceleration = cutoff * (velocity - smoothed)  # d/dt of the velocity, low-passed
     damping = tune["velocity_derivative_gain"] * ca.vertcat(acceleration[:2], 0)

@@ -67,24 +67,26 @@ class ClosedLoop:
         flight = ca.SX.sym("x", FLIGHT_STATE_SIZE)
         target, offset, wind = ca.SX.sym("t", 3), ca.SX.sym("d", 3), ca.SX.sym("w", 3)
         speed, surfaces = ca.SX.sym("s"), ca.SX.sym("h", SURFACES_SIZE)
-        tuning = ca.SX.sym("k", TUNING_SIZE)
+        tuning, feedforward = ca.SX.sym("k", TUNING_SIZE), ca.SX.sym("v", 3)
+        elapsed = ca.SX.sym("e")  # since the step began: the target moves on at the feed-forward
         state, controller = flight[:STATE_SIZE], flight[CONTROLLER]
-        command, controller_rate = motor_commands(
-            body, loops, state, controller, (target, offset, speed, tuning)
-        )
+        moving = (target + feedforward * elapsed, offset, speed, tuning, feedforward)
+        command, controller_rate = motor_commands(body, loops, state, controller, moving)
         after = runge_kutta_substep(body, state, command, wind, surfaces, h)
         after = ca.vertcat(after, controller + h * controller_rate)
-        inputs = [flight, target, offset, speed, tuning, surfaces, wind]
+        inputs = [flight, target, offset, speed, tuning, feedforward, surfaces, wind, elapsed]
         substep = ca.Function("flight", inputs, [after])
         # the state after every few substeps (at most PATH_INTERVAL_S apart): the path
         stride = path_stride(self.substeps, h)
         stretch = substep.fold(stride) if stride > 1 else substep
         stretches = stretch.mapaccum(self.substeps // stride)
-        sizes = (("t", 3), ("d", 3), ("s", 1), ("k", TUNING_SIZE), ("h", SURFACES_SIZE))
-        held = [ca.MX.sym(name, size) for name, size in sizes]
+        sizes = (("t", 3), ("d", 3), ("s", 1), ("k", TUNING_SIZE), ("v", 3))
+        held = [ca.MX.sym(name, size) for name, size in (*sizes, ("h", SURFACES_SIZE))]
         gusty = ca.MX.sym("w", 3, self.substeps)  # the wind at each substep
         start = ca.MX.sym("x", FLIGHT_STATE_SIZE)
-        states = stretches(start, *(ca.repmat(value, 1, self.substeps) for value in held), gusty)
+        clock = ca.DM(np.arange(self.substeps) * h).T  # each substep's start in the step
+        repeated = (ca.repmat(value, 1, self.substeps) for value in held)
+        states = stretches(start, *repeated, gusty, clock)
         final = states[:, -1]
         path = ca.vertcat(states[POSITION, :], states[ATTITUDE, :])
         step = ca.Function("flight_step", [start, *held, gusty], [final, path])
@@ -99,15 +101,18 @@ class ClosedLoop:
         wind: np.ndarray,
         surfaces: np.ndarray = OPEN_AIR,
         tuning: np.ndarray | None = None,
+        feedforward: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """(the state a step later, (n, 7) the position and attitude after every few
         substeps, the last one the step's end: :func:`path_stride`); ``wind`` (3,) held over
         the step, or (substeps, 3) one vector a substep; ``surfaces`` the heights above, then
         below, each rotor (:data:`~vehicle_sim.dynamics.rigid_body.OPEN_AIR`: none near);
-        ``tuning`` the loops' tunable values (None: the settings')."""
+        ``tuning`` the loops' tunable values (None: the settings'); ``feedforward`` the
+        setpoint's velocity (None: none), along which the target moves over the step."""
         wind = np.asarray(wind, dtype=float)
         winds = np.repeat(wind.reshape(3, 1), self.substeps, axis=1) if wind.ndim == 1 else wind.T
         tuning = self.tuning if tuning is None else tuning
-        held = (target, belief_offset, speed_limit_m_s, tuning, surfaces)
+        feedforward = np.zeros(3) if feedforward is None else feedforward
+        held = (target, belief_offset, speed_limit_m_s, tuning, feedforward, surfaces)
         final, path = self._step(state, *held, winds)
         return np.asarray(final, dtype=float).reshape(FLIGHT_STATE_SIZE), np.asarray(path).T

@@ -16,6 +16,7 @@ class Kinematics:
     truth: np.ndarray
     believed: np.ndarray
     target: np.ndarray | None = None
+    target_velocity: np.ndarray | None = None  # a setpoint's velocity: the target moves on
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
     path: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # the last step's ends
 
@@ -32,19 +33,24 @@ class Kinematics:
     def hold(self) -> None:
         """Hold where the autopilot believes it is."""
         self.target = self.believed.copy()
+        self.target_velocity = None
 
     def stop_at(self, position: np.ndarray) -> None:
         """Stopped dead at ``position`` (a crash): truth and belief there, no target."""
         self.truth = np.asarray(position, dtype=float).reshape(3).copy()
         self.believed = self.truth.copy()
         self.target = None
+        self.target_velocity = None
         self.velocity = np.zeros(3)
 
     def step(
         self, dt_s: float, speed_limit_m_s: float, rng: np.random.Generator, noise_m: float
     ) -> np.ndarray:
-        """Advance ``dt_s``: move by (target - believed), at most speed * dt; return the move."""
+        """Advance ``dt_s``: move by (target - believed), at most speed * dt, the target where
+        its velocity takes it by the step's end; return the move."""
         move = np.zeros(3)
+        if self.target is not None and self.target_velocity is not None:
+            self.target = self.target + self.target_velocity * dt_s
         if self.target is not None:
             wanted = self.target - self.believed
             distance = float(np.linalg.norm(wanted))

@@ -75,6 +75,7 @@ class Multicopter:
         self.tuning = loop.tuning.copy()
         self.offset = np.zeros(3)  # believed - true position
         self.target: np.ndarray | None = None
+        self.target_velocity: np.ndarray | None = None  # a setpoint's: the target moves on
         self.path = self._pose()[None]  # true poses (position, attitude) over the last step
 
     def _resting(self, position: np.ndarray) -> np.ndarray:
@@ -162,6 +163,7 @@ class Multicopter:
     def hold(self) -> None:
         """Hold where the autopilot believes it is."""
         self.target = self.believed.copy()
+        self.target_velocity = None
 
     def stop_at(self, position: np.ndarray) -> None:
         """Stopped dead at ``position`` (a crash): still, level, believing the truth, no
@@ -169,12 +171,14 @@ class Multicopter:
         self.state = self._resting(position)
         self.offset = np.zeros(3)
         self.target = None
+        self.target_velocity = None
 
     def step(
         self, dt_s: float, speed_limit_m_s: float, rng: np.random.Generator, noise_m: float
     ) -> np.ndarray:
-        """Fly ``dt_s`` (the loop's step) toward the target (none: hold); return the move
-        the autopilot believes it made."""
+        """Fly ``dt_s`` (the loop's step) toward the target (none: hold), moving on at the
+        setpoint's velocity (its feed-forward) if it has one; return the move the autopilot
+        believes it made."""
         if dt_s != self.loop.step_s:
             raise ValueError(f"this body flies steps of {self.loop.step_s} s, not {dt_s}")
         before = self.believed
@@ -189,7 +193,10 @@ class Multicopter:
             wind,
             self._surfaces_near(),
             self.tuning,
+            self.target_velocity,
         )
+        if self.target is not None and self.target_velocity is not None:
+            self.target = self.target + self.target_velocity * dt_s
         if self.drift_rng is not None:  # the filter's velocity error, integrated over the step
             noise = self.drift_rng.normal(0.0, self.loop.loops.velocity_noise_m_s, 3)
             self.offset = self.offset + (self.velocity_bias + noise) * dt_s

@@ -28,6 +28,7 @@ def fly_mission(vehicle: Any) -> None:
         return
     target = item_position(vehicle, item)
     vehicle.kinematics.target = target
+    vehicle.kinematics.target_velocity = None
     acceptance = item.param2 if item.param2 > 0 else vehicle.scenario.control.arrival_tol_m
     if np.linalg.norm(target - vehicle.kinematics.believed) < acceptance:
         if current + 1 < len(items):

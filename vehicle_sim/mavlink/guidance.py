@@ -1,4 +1,8 @@
-"""Which position targets a guided vehicle accepts: the message's own form, then the fence."""
+"""Which position targets a guided vehicle accepts: the message's own form, then the fence.
+
+A target is a position, or a position and a velocity (ArduPilot's GUIDED takes both: the
+target then moves on at that velocity, which the autopilot also feeds forward, until the next
+setpoint or the failsafe). Acceleration, force, yaw and yaw rate are not taken."""
 
 from __future__ import annotations
 
@@ -8,10 +12,13 @@ from typing import Any
 import numpy as np
 from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 
+from mission.world.frames import ned_to_enu
 from mission.world.model import KnownWorld
 
-POSITION_ONLY_MASK_REQUIRED = 0b0000_0001_1111_1000  # velocity + acceleration ignored
+ACCELERATION_BITS = 0b0000_0001_1100_0000  # ignored, always
+VELOCITY_BITS = 0b0000_0000_0011_1000  # all ignored, or none
 POSITION_BITS = 0b0000_0000_0000_0111
+MAX_SETPOINT_SPEED_M_S = 50.0
 FORCE_BIT = 0b0000_0010_0000_0000
 MAX_ABS_COORD_M = 100_000.0
 
@@ -22,15 +29,32 @@ def setpoint_problem(msg: Any, guided: bool) -> tuple[str, str] | None:
     if msg.coordinate_frame != mavlink2.MAV_FRAME_LOCAL_NED:
         return "frame", f"frame {msg.coordinate_frame}, LOCAL_NED only"
     mask = int(msg.type_mask)
-    ignores_motion = (mask & POSITION_ONLY_MASK_REQUIRED) == POSITION_ONLY_MASK_REQUIRED
-    if mask & POSITION_BITS or not ignores_motion or mask & FORCE_BIT:
-        return "type_mask", f"type_mask {mask}, position targets only"
+    ignores_acceleration = (mask & ACCELERATION_BITS) == ACCELERATION_BITS
+    velocity_bits = mask & VELOCITY_BITS
+    if (
+        mask & POSITION_BITS
+        or not ignores_acceleration
+        or velocity_bits not in (0, VELOCITY_BITS)
+        or mask & FORCE_BIT
+    ):
+        return "type_mask", f"type_mask {mask}, position (and velocity) targets only"
     values = (msg.x, msg.y, msg.z)
     if not all(math.isfinite(v) and abs(v) < MAX_ABS_COORD_M for v in values):
         return "out of range", "position out of range"
+    if velocity_bits == 0 and not all(
+        math.isfinite(v) and abs(v) <= MAX_SETPOINT_SPEED_M_S for v in (msg.vx, msg.vy, msg.vz)
+    ):
+        return "out of range", "velocity out of range"
     if not guided:
         return "not guided", "not armed in GUIDED"
     return None
+
+
+def setpoint_velocity(msg: Any) -> np.ndarray | None:
+    """The velocity (ENU) of an accepted setpoint, None for a position-only one."""
+    if int(msg.type_mask) & VELOCITY_BITS:
+        return None
+    return ned_to_enu(np.array([msg.vx, msg.vy, msg.vz], dtype=float))
 
 
 def geofence_problem(

@@ -18,7 +18,12 @@ from pymavlink.dialects.v20 import ardupilotmega as mavlink2
 from mission.world.frames import ned_to_enu
 from vehicle_sim.mavlink import modes
 from vehicle_sim.mavlink.commands import execute, set_mode
-from vehicle_sim.mavlink.guidance import MAX_ABS_COORD_M, geofence_problem, setpoint_problem
+from vehicle_sim.mavlink.guidance import (
+    MAX_ABS_COORD_M,
+    geofence_problem,
+    setpoint_problem,
+    setpoint_velocity,
+)
 
 WARNING_REPEAT_S = 5.0
 ESTIMATE_RESTART_S = 2.0  # an estimate stamped further back than this is a sender restarted
@@ -49,6 +54,7 @@ def on_setpoint(vehicle: Any, msg: Any) -> None:
         warn_once(vehicle, f"Setpoint rejected: {detail}")
         return
     kinematics.target = target
+    kinematics.target_velocity = setpoint_velocity(msg)
     vehicle.last_setpoint_s = vehicle.sim_time_s
     if vehicle.failsafe:
         vehicle.failsafe = False
@@ -61,7 +67,7 @@ def _repeated_setpoint(vehicle: Any, msg: Any) -> bool:
     if not stamp:
         return False
     sender = (msg.get_srcSystem(), msg.get_srcComponent())
-    seen = (stamp, msg.type_mask, msg.coordinate_frame, msg.x, msg.y, msg.z)
+    seen = (stamp, msg.type_mask, msg.coordinate_frame, msg.x, msg.y, msg.z, msg.vx, msg.vy, msg.vz)
     if vehicle.last_setpoint_seen.get(sender) == seen:
         return True
     vehicle.last_setpoint_seen[sender] = seen
