@@ -37,7 +37,12 @@ from mission.link.fast_decode import FastDecoder
 from mission.link.statustext import StatusChunks
 from mission.link.vehicle_events import parse_event
 from mission.link.vehicle_identity import VehicleIdentity
-from mission.world.frames import GeodeticFrame, ned_to_enu
+from mission.world.frames import (
+    GeodeticFrame,
+    ned_to_enu,
+    quaternion_matrix,
+    swap_attitude_frames,
+)
 from mission.world.model import World
 
 GCS_SYSTEM_ID = 255
@@ -100,6 +105,8 @@ def trace_of_messages(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
         if kind == "SIM_STATE" and source != GCS_SYSTEM_ID:
             truth = frame.from_degE7(message.lat_int, message.lon_int, message.alt)
             samples.pending[TRUTH][source] = truth
+            attitude = (message.q1, message.q2, message.q3, message.q4)
+            samples.pending[ATTITUDE][source] = swap_attitude_frames(quaternion_matrix(attitude))
         elif kind == "GPS_RAW_INT" and source != GCS_SYSTEM_ID:
             if message.fix_type >= MIN_3D_FIX:
                 fix = frame.from_degE7(message.lat, message.lon, message.alt / 1000.0)
@@ -129,7 +136,8 @@ def trace_of_messages(messages: Iterable[Any], scenario: Scenario) -> RunTrace:
                 _station_said(trace, text, t)
     offsets = {} if trace.ticks else clock_offsets(replies)
     epoch_usec = round(epoch * 1e6)
-    for kind, into in ((TRUTH, trace.truth), (BELIEF, trace.beliefs), (FIX, trace.fixes)):
+    kinds = (TRUTH, ATTITUDE, BELIEF, FIX)
+    for kind, into in zip(kinds, (trace.truth, trace.attitudes, trace.beliefs, trace.fixes)):
         for system, stamp, position in samples.stamped[kind]:
             if trace.ticks or system in offsets:
                 into[(system, truth_time(stamp, epoch_usec, offsets.get(system, 0.0)))] = position
@@ -190,7 +198,7 @@ def _station_said(trace: RunTrace, text: str, t: float) -> None:
         trace.link_events.append({"t": t, "event": text})
 
 
-TRUTH, BELIEF, FIX = "truth", "belief", "fix"
+TRUTH, ATTITUDE, BELIEF, FIX = "truth", "attitude", "belief", "fix"
 
 
 class _StepSamples:
@@ -199,12 +207,9 @@ class _StepSamples:
     that step's SYSTEM_TIME marker stamps them: (system, stamp in usec, position)."""
 
     def __init__(self) -> None:
-        self.pending: dict[str, dict[int, np.ndarray]] = {TRUTH: {}, BELIEF: {}, FIX: {}}
-        self.stamped: dict[str, list[tuple[int, int, np.ndarray]]] = {
-            TRUTH: [],
-            BELIEF: [],
-            FIX: [],
-        }
+        kinds = (TRUTH, ATTITUDE, BELIEF, FIX)
+        self.pending: dict[str, dict[int, np.ndarray]] = {kind: {} for kind in kinds}
+        self.stamped: dict[str, list[tuple[int, int, np.ndarray]]] = {kind: [] for kind in kinds}
 
     def stamp(self, system: int, usec: int) -> None:
         """The step's marker: what ``system`` sent before it is stamped with ``usec``."""

@@ -1,8 +1,9 @@
 """How close a run came, from the truth in its tlog: the closest approach of every pair of UAVs,
 each UAV's least clearance from the structure and the ground, the control cycles at which a
 margin was broken, the contacts the vehicles reported, the pairs and vehicles whose truth
-touched (whether or not a vehicle said so: a run with ``stop_on_crash`` false flies on), and
-the worst moments.
+touched (whether or not a vehicle said so: a run with ``stop_on_crash`` false flies on; a
+flying quadrotor's rotor rims and frame, :mod:`~mission.analysis.body_clearance`, a kinematic
+point's sphere), and the worst moments.
 
 Between two truth samples each vehicle is taken to fly straight (as it does in a step): a pair's
 closest approach over the interval is exact for that motion
@@ -17,6 +18,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from mission.analysis.body_clearance import attitudes_at, body_touches
+from mission.world.contact_body import ContactBody
 from mission.world.model import World
 from mission.world.proximity import StructureProximity, closest_approach, segment_points
 
@@ -25,6 +28,7 @@ class RunTrace(Protocol):
     """What this module reads of :class:`mission.analysis.metrics.RunTrace` (which calls it)."""
 
     truth: dict[tuple[int, float], np.ndarray]
+    attitudes: dict[tuple[int, float], np.ndarray]
     contacts: list[dict[str, Any]]
 
     @property
@@ -101,6 +105,23 @@ def track_clearance(
     return best
 
 
+def _bodies_touching(
+    trace: RunTrace,
+    world: World,
+    proximity: StructureProximity,
+    times: np.ndarray,
+    tracks: dict[int, np.ndarray],
+) -> list[str]:
+    """The flying vehicles whose rotor rims or frame touched the structure or the ground."""
+    body = ContactBody.of(world.scenario.vehicle.multicopter)
+    touching = []
+    for system, track in tracks.items():
+        attitudes = attitudes_at(trace.attitudes, system, times)
+        if body_touches(proximity, body, (times, track, attitudes)):
+            touching.append(_name(system))
+    return sorted(touching)
+
+
 def safety_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
     """The ``safety`` block of summary.json."""
     scenario = world.scenario
@@ -140,6 +161,8 @@ def safety_metrics(trace: RunTrace, world: World) -> dict[str, Any]:
         below_clearance |= gaps < clearance
     touching_pairs = sorted(p for p, d in approaches.items() if d < 2 * radius)
     touching_vehicles = sorted(v for v, d in clearances.items() if d < radius)
+    if scenario.vehicle.dynamics == "multicopter":  # its rims and frame, not the sphere
+        touching_vehicles = _bodies_touching(trace, world, proximity, times, tracks)
     return {
         "radius_m": radius,
         "min_separation_m": separation,

@@ -16,6 +16,8 @@ class RunTrace:
     """What a ground station's tlog says about a run, in simulated seconds."""
 
     truth: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
+    # the true attitude with it (body FLU to world ENU, 3 x 3)
+    attitudes: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)
     estimates: dict[float, np.ndarray] = field(default_factory=dict)  # the work UAV's, by time
     # every vehicle's belief (LOCAL_POSITION_NED), setpoints and the estimates sent before them
     beliefs: dict[tuple[int, float], np.ndarray] = field(default_factory=dict)

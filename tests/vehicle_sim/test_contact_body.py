@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from mission.config.scenario import load_scenario
+from mission.world.contact_body import ContactBody
 from mission.world.proximity import StructureProximity
 from vehicle_sim.dynamics.contact import GROUND, STRUCTURE, ContactDetector
-from vehicle_sim.dynamics.contact_body import ContactBody
 
 VEHICLE = replace(load_scenario("along").vehicle, dynamics="multicopter", radius_m=None)
 BODY = VEHICLE.multicopter

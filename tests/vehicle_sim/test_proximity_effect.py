@@ -15,11 +15,11 @@ from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY as G
 from mission.config.proximity_laws import ceiling_gain, ground_gain
 from mission.config.scenario import load_scenario
+from mission.world.contact_body import ContactBody
 from mission.world.proximity import StructureProximity
 from mission.world.surfaces import VerticalSurfaces
 from tests.vehicle_sim.rigid_body_alone import RigidBody
 from vehicle_sim.dynamics.contact import STRUCTURE, ContactDetector
-from vehicle_sim.dynamics.contact_body import ContactBody
 from vehicle_sim.dynamics.multicopter import Multicopter
 from vehicle_sim.dynamics.rigid_body import OPEN_AIR, POSITION, RATES, resting_state
 

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mission.world.contact_body import ContactBody
 from mission.world.frames import enu_to_ned, ned_to_enu
 from mission.world.proximity import StructureProximity, closest_approach, segment_points
-from vehicle_sim.dynamics.contact_body import ContactBody
 
 CLEAR_SLACK_M = 1e-6  # rounding's share in the shortcut of a path clear of everything
 STRUCTURE = "structure"

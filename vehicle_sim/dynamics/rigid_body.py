@@ -46,9 +46,8 @@ POSITION, VELOCITY, ATTITUDE, RATES, THRUSTS = (
     slice(10, 13),
     slice(13, 17),
 )
-# rotor angles from the nose toward the left, and spin: +1 counter-clockwise seen from above
-# (PX4's quad X: front-right and rear-left counter-clockwise)
-ROTOR_ANGLES_DEG = (45.0, 135.0, 225.0, 315.0)
+# each rotor's spin: +1 counter-clockwise seen from above (PX4's quad X: front-right and
+# rear-left counter-clockwise; the rotors' angles: multicopter_settings.ROTOR_ANGLES_DEG)
 ROTOR_SPINS = (-1.0, 1.0, -1.0, 1.0)
 SURFACES_SIZE = 8  # the heights of the surface above each rotor, then below each
 OPEN_AIR = np.array([1.0e6] * 4 + [-1.0e6] * 4)  # nothing near: no gain worth the name
@@ -65,12 +64,8 @@ def rotation(q: ca.SX) -> ca.SX:
 
 
 def rotor_offsets(settings: MulticopterSettings) -> np.ndarray:
-    """(4, 3): each rotor's hub in the body frame (FLU, m): at (+-L, +-L), L the lever,
-    ``rotor_height_m`` above the centre of mass."""
-    angles = np.radians(ROTOR_ANGLES_DEG)
-    arm = settings.rotor_arm_m
-    height = np.full(4, settings.rotor_height_m)
-    return np.column_stack([arm * np.cos(angles), arm * np.sin(angles), height])
+    """(4, 3): each rotor's hub in the body frame (FLU, m)."""
+    return settings.rotor_hubs()
 
 
 def near_surfaces(settings: MulticopterSettings, state: ca.SX, surfaces: ca.SX) -> ca.SX:

@@ -19,7 +19,6 @@ import numpy as np
 
 from mission.config.multicopter_settings import MulticopterSettings
 from mission.world.frames import quaternion_matrix
-from vehicle_sim.dynamics.rigid_body import rotor_offsets
 
 RIM_POINTS = 12
 
@@ -38,7 +37,7 @@ class ContactBody:
         ring = body.rotor_radius_m * np.column_stack(
             [np.cos(angles), np.sin(angles), np.zeros(RIM_POINTS)]
         )
-        rims = np.vstack([hub + ring for hub in rotor_offsets(body)])
+        rims = np.vstack([hub + ring for hub in body.rotor_hubs()])
         tolerance = body.rotor_radius_m * math.sin(math.pi / RIM_POINTS)  # half the spacing
         points = np.vstack([np.zeros((1, 3)), rims])
         radii = np.concatenate([[body.lever_m / 2], np.full(len(rims), tolerance)])
@@ -50,8 +49,12 @@ class ContactBody:
         return float(np.max(np.linalg.norm(self.points, axis=1) + self.radii))
 
     def placed(self, poses: np.ndarray) -> np.ndarray:
-        """(n, k, 3): the points at each of ``poses`` ((n, 7): position, attitude)."""
-        placed = [
-            pose[:3] + self.points @ quaternion_matrix(pose[3:7]).T for pose in np.atleast_2d(poses)
-        ]
-        return np.array(placed)
+        """(n, k, 3): the points at each of ``poses`` ((n, 7): position, attitude quaternion
+        body FLU to world ENU)."""
+        rotations = [quaternion_matrix(pose[3:7]) for pose in np.atleast_2d(poses)]
+        return self.rotated(np.atleast_2d(poses)[:, :3], np.array(rotations))
+
+    def rotated(self, centres: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+        """(n, k, 3): the points about each of ``centres`` (n, 3) turned by ``rotations``
+        (n, 3, 3: body FLU to world ENU)."""
+        return centres[:, None, :] + np.einsum("nij,kj->nki", rotations, self.points)
