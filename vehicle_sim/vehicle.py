@@ -23,6 +23,7 @@ from mission.link.mavlink_udp import LinkCounters
 from mission.link.statustext import statustexts
 from mission.link.vehicle_events import event_text, parameter_change
 from mission.link.vehicle_identity import VehicleIdentity
+from mission.world.contact_body import ContactBody
 from mission.world.frames import GeodeticFrame
 from mission.world.model import World
 from mission.world.proximity import StructureProximity
@@ -67,7 +68,10 @@ class Vehicle:
         seeds = np.random.SeedSequence([seed, identity.instance]).spawn(6)
         gnss_rng, camera_rng, self.rng_motion, _, wind, drift = map(rng, seeds)
         self.kinematics = vehicle_motion(world, self.home, wind, drift)
-        detector = ContactDetector(StructureProximity(world.structure), scenario.vehicle.radius_m)
+        flying = scenario.vehicle.dynamics == "multicopter"  # its rims and frame strike things
+        body = ContactBody.of(scenario.vehicle.multicopter) if flying else None
+        proximity = StructureProximity(world.structure)
+        detector = ContactDetector(proximity, scenario.vehicle.radius_m, body)
         self.watch = ContactWatch(detector, scenario.run.stop_on_crash)
         self._last_move = (as_sent(self.home), as_sent(self.home))  # the last step, as sent
         self.armed = False

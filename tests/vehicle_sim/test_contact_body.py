@@ -69,3 +69,21 @@ def test_a_body_sinking_to_the_ground_touches_it_with_its_frame(detector):
     assert _held_at(detector, np.array([0.0, -20.0, BODY.lever_m / 2 + 0.01])) == []
     touching = _held_at(detector, np.array([0.0, -20.0, BODY.lever_m / 2 - 0.01]))
     assert [c.other for c in touching] == [GROUND]
+
+
+def test_a_flying_vehicle_checks_its_rims_and_frame_not_its_bounding_sphere(along_world):
+    from mission.link.vehicle_identity import VehicleIdentity
+    from mission.world.model import World
+    from vehicle_sim.mavlink import modes
+    from vehicle_sim.vehicle import Vehicle
+
+    flying = World(replace(along_world.scenario, vehicle=VEHICLE))
+    sent: list = []
+    home = np.array([0.0, 0.0, 8.0 - 0.2])  # 0.2 m under the deck: inside the 0.41 m sphere
+    vehicle = Vehicle(VehicleIdentity.parse("work"), flying.scenario, flying, home, 0, sent.append)
+    vehicle.change_mode(modes.GUIDED)
+    vehicle.arm(True)
+    for _ in range(4):
+        vehicle.step()
+    assert vehicle.watch.detector.body is not None
+    assert not [m for m in sent if m.get_type() == "STATUSTEXT" and "structure" in m.text]
