@@ -12,30 +12,30 @@ h in feet.
 **The field** is a sum of random Fourier modes, ``u(x) = sum_n a_n cos(k_n . x + psi_n)`` with
 ``a_n`` perpendicular to ``k_n`` (divergence-free), of a homogeneous isotropic field whose
 longitudinal correlation is Dryden's ``f(r) = exp(-r / L)``: its energy spectrum is
-``E(k) = (8 sigma^2 L / pi) (kL)^4 / (1 + (kL)^2)^3`` (``E11 = 1/2 k^3 d/dk (1/k dE11/dk)``
-of the one-dimensional ``E11 = (2 sigma^2 L / pi) / (1 + (kL)^2)``), so the transverse
+``E(k) = (8 sigma^2 L / pi) (kL)^4 / (1 + (kL)^2)^3`` (``E = 1/2 k^3 d/dk (1/k dE11/dk)`` of
+the one-dimensional ``E11 = (2 sigma^2 L / pi) / (1 + (kL)^2)``), so the transverse
 correlation is ``g(r) = exp(-r / L) (1 - r / 2L)`` and the spectra along a line are Dryden's
 ``H_u``, ``H_v`` and ``H_w``. Two such fields, since L differs by axis: one of scale ``L_u``
 and intensity ``sigma_u`` gives the two horizontal components, one of ``L_w`` and ``sigma_w``
 the vertical one (their cross-correlation is zero, as in an isotropic field at one point).
 Each field has ``SHELLS`` wavenumber shells: in kL one from 0 to ``KL_LOW``, log-spaced ones to
-``KL_HIGH``, and the tail (0.6 % of the energy) from there to ``KL_TOP`` (the 0.02 % beyond is
-left out and the rest scaled to the whole variance); a shell's energy is E(k)'s integral over
-it. In a shell the
-wavevectors point along the six axes of an icosahedron turned by a random rotation of the
-shell's own, two perpendicular polarisations each, each with a random phase, and each
-wavenumber is drawn from E(k) within the shell. The six axes make ``sum_d d d^T`` a multiple
-of the identity, so every component's variance is sigma^2 in every draw, not on average only;
-drawing the wavenumbers from E(k) makes the expected correlation at any separation the
-spectrum's exactly. The frozen field is carried along the mean wind V:
+``KL_HIGH``, and the tail (0.85 % of the energy) from there to ``KL_TOP`` (the 0.02 % beyond
+is left out and the rest scaled to the whole variance); a shell's energy is E(k)'s integral
+over it. In a shell the wavevectors point along the six axes of an icosahedron turned by a
+random rotation of the shell's own, two perpendicular polarisations each, each with a random
+phase, and each wavenumber is drawn from E(k) within the shell. The six axes make
+``sum_d d d^T`` a multiple of the identity, so every component's variance is sigma^2 in every
+draw, not on average only; drawing the wavenumbers from E(k) makes the expected correlation at
+any separation the spectrum's exactly. The frozen field is carried along the mean wind V:
 ``gust(x, t) = u(x - V t)`` (Taylor's hypothesis at one speed for every height).
 
-**Cheap over a step**: a vehicle samples the field at one point for ``count`` substeps
-``tau_j = j dt`` after ``t0``; with ``phi_n = k_n . x - omega_n t0 + psi_n`` and
-``omega_n = k_n . V``, ``cos(phi_n - omega_n tau_j) = cos(phi_n) cos(omega_n tau_j) +
-sin(phi_n) sin(omega_n tau_j)``: the step's cosines and sines of ``omega_n tau_j`` are kept, so
-a step is ``2N`` trigonometric values and one matrix product ``(count, 2N) x (2N, 3)`` in single
-precision (0.05 ms for 125 substeps and N = 840; the gusts good to ~1e-6 of themselves).
+**Cheap over a step**: a vehicle samples the field at one point for ``count`` substeps. With
+``phi_n = k_n . x - omega_n t_m + psi_n`` at the step's middle ``t_m`` and ``omega_n = k_n . V``,
+the sample ``d`` after the middle is ``sum_n a_n (cos(phi_n) cos(omega_n d) + sin(phi_n)
+sin(omega_n d))`` and the one ``d`` before it the same with a minus: the cosines and sines of
+``omega_n d`` over half a step are kept (single precision), so a step is ``2N`` trigonometric
+values and two matrix products ``(count / 2, N) x (N, 3)`` (0.04 ms for 125 substeps and
+N = 840 in one process; the gusts good to ~1e-6 of themselves).
 """
 
 from __future__ import annotations
@@ -49,11 +49,8 @@ FEET = 0.3048
 REFERENCE_HEIGHT_M = 20 * FEET  # W20's height: the field's intensities and scale lengths
 WIND_STREAM = 0x57494E44  # "WIND": the run's seed and this make the field's generator
 SHELLS = (30, 40)  # wavenumber shells of the horizontal field (L_u), of the vertical (L_w)
-KL_LOW, KL_HIGH, KL_TOP = (
-    0.05,
-    200.0,
-    1e4,
-)  # shells in kL: [0, LOW], log-spaced to HIGH, [HIGH, TOP]
+# the shells in kL: [0, KL_LOW], log-spaced ones to KL_HIGH, the tail [KL_HIGH, KL_TOP]
+KL_LOW, KL_HIGH, KL_TOP = 0.05, 200.0, 1e4
 GOLDEN = (1 + math.sqrt(5)) / 2
 # the six axes through an icosahedron's opposite vertices: sum d d^T = 2 I
 ICOSAHEDRON_AXES = np.array(
@@ -146,7 +143,8 @@ def isotropic_modes(
     drawn = below[:-1, None] + np.diff(below)[:, None] * rng.random((shells, axes))
     kl = wavenumbers_of(drawn, edges[:-1, None], edges[1:, None])  # (shells, axes)
     directions = np.einsum("sij,dj->sdi", turned, ICOSAHEDRON_AXES)
-    first = np.cross(directions, [0.3, 0.5, 0.8])  # any vector off the axes
+    least_along = np.eye(3)[np.argmin(np.abs(directions), axis=-1)]  # never parallel
+    first = np.cross(directions, least_along)
     first /= np.linalg.norm(first, axis=-1, keepdims=True)
     second = np.cross(directions, first)
     # each polarisation's mode carries half its amplitude^2 as variance: D q^2 = 2 E per shell
@@ -158,7 +156,9 @@ def isotropic_modes(
 
 
 class FrozenTurbulence:
-    """The run's gust field (ENU, m/s): ``sum_n a_n cos(k_n . (x - V t) + psi_n)``."""
+    """The run's gust field (ENU, m/s): ``sum_n a_n cos(k_n . (x - V t) + psi_n)``, the
+    horizontal components from one set of modes, the vertical from another (each mode's
+    amplitude is zero in the components its set does not feed)."""
 
     def __init__(
         self,
@@ -167,11 +167,11 @@ class FrozenTurbulence:
         phases: np.ndarray,
         carried: np.ndarray,
     ) -> None:
-        self.wavevectors = wavevectors
-        self.amplitudes = amplitudes
-        self.phases = phases
+        self.wavevectors = wavevectors  # (N, 3), rad/m
+        self.amplitudes = amplitudes  # (N, 3), m/s
+        self.phases = phases  # (N,)
         self.frequencies = wavevectors @ np.asarray(carried, dtype=float)  # omega_n, rad/s
-        self._steps: dict[tuple[int, float], np.ndarray] = {}  # a step's cosines and sines
+        self._steps: dict = {}  # per (count, dt): a step's cosines and sines
 
     @classmethod
     def of(cls, seed: int, scales: DrydenScales, carried: np.ndarray) -> FrozenTurbulence:
@@ -191,27 +191,37 @@ class FrozenTurbulence:
 
     def at(self, points: np.ndarray, time_s: float) -> np.ndarray:
         """(P, 3): the gusts at ``points`` (P, 3) at ``time_s``."""
-        phase = self._phases(np.atleast_2d(points), time_s)
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        phase = points @ self.wavevectors.T - self.frequencies * time_s + self.phases
         return np.cos(phase) @ self.amplitudes
 
     def over_step(self, point: np.ndarray, start_s: float, dt_s: float, count: int) -> np.ndarray:
-        """(count, 3): the gusts at ``point`` at ``start_s + j dt_s``, j < ``count``."""
-        phase = self._phases(np.asarray(point, dtype=float).reshape(1, 3), start_s)[0]
-        weights = np.empty((2 * len(phase), 3), dtype=np.float32)
-        weights[: len(phase)] = np.cos(phase)[:, None] * self.amplitudes
-        weights[len(phase) :] = np.sin(phase)[:, None] * self.amplitudes
-        return (self._step_basis(count, dt_s) @ weights).astype(float)
+        """(count, 3): the gusts at ``point`` at ``start_s + j dt_s``, j < ``count``: from the
+        step's middle, ``cos(phi - omega d) = cos(phi) cos(omega d) + sin(phi) sin(omega d)``
+        at ``d`` after it and ``cos(phi) cos(omega d) - sin(phi) sin(omega d)`` before it."""
+        cosines, sines = self._step_bases(count, dt_s)
+        middle_s = start_s + 0.5 * (count - 1) * dt_s
+        phase = self.wavevectors @ np.asarray(point, dtype=float) - self.frequencies * middle_s
+        phase += self.phases
+        even = cosines @ (np.cos(phase)[:, None] * self.amplitudes).astype(np.float32)
+        odd = sines @ (np.sin(phase)[:, None] * self.amplitudes).astype(np.float32)
+        half = len(even)
+        gusts = np.empty((count, 3))
+        gusts[count - half :] = even + odd
+        gusts[:half] = (even - odd)[::-1]
+        return gusts
 
-    def _phases(self, points: np.ndarray, time_s: float) -> np.ndarray:
-        """(P, N): ``k_n . x - omega_n t + psi_n``."""
-        return points @ self.wavevectors.T - self.frequencies * time_s + self.phases
-
-    def _step_basis(self, count: int, dt_s: float) -> np.ndarray:
-        """(count, 2N): ``cos(omega_n tau_j)`` then ``sin(omega_n tau_j)``, kept per step (in
-        single precision: the product reads a third of the memory, the gusts good to ~1e-6
-        of themselves)."""
+    def _step_bases(self, count: int, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """(half the step, N) each: ``cos(omega_n d_m)`` and ``sin(omega_n d_m)`` at the
+        offsets ``d_m`` from the step's middle, kept per step (in single precision: the
+        products read a quarter of the memory of every substep's in double; the gusts good to
+        ~1e-6 of themselves)."""
         key = (count, dt_s)
         if key not in self._steps:
-            turned = np.outer(np.arange(count) * dt_s, self.frequencies)
-            self._steps[key] = np.hstack([np.cos(turned), np.sin(turned)]).astype(np.float32)
+            offsets = (np.arange((count + 1) // 2) + (0.0 if count % 2 else 0.5)) * dt_s
+            turned = np.outer(offsets, self.frequencies)
+            self._steps[key] = (
+                np.cos(turned).astype(np.float32),
+                np.sin(turned).astype(np.float32),
+            )
         return self._steps[key]

@@ -20,16 +20,19 @@ speeds up past the bluff body: mean and gusts ``edge_gain`` times the free strea
 **The wake** raises the turbulence: PRIME's building-wake model (Schulman, Strimaitis and
 Scire 2000, J. Air & Waste Manage. Assoc. 50:378-390; EPA AERMOD's ``prime.f``: the wake's
 sigma_v and sigma_w 1.7 times the ambient ones at the lee face, Weil 1996, its speed deficit
-0.7, both fading as ``((x + R) / R)^(-2/3)`` with the distance x behind the lee face, and
-rising linearly over the roof from the upwind face). Here: a point in a deck's shadow along
-the mean wind, at or below its top, is in its wake; under the deck the gusts' gain rises from
-1 at the upwind edge to ``wake_gust_gain`` at the lee edge (in proportion to the way across),
-behind it ``1 + (wake_gust_gain - 1) ((x + R) / R)^(-2/3)`` up to 15 R downstream (PRIME's
-wake reach), R = ``min(H, W)^(2/3) max(H, W)^(1/3)``, H the deck's thickness and W its width
-across the wind (each at most 8 times the other, Wilson's limits as PRIME applies them). The
-mean speed behind the deck is the free stream's (PRIME's deficit is not modelled there); under
-it the shelter above. So the turbulence intensity (gust sigma over the mean speed) rises under
-and behind a deck: 1.7 / 0.97 of the free stream's at the lee edge, 1.35 / 0.36 mid-deck.
+0.7, both fading as ``((x + R) / R)^(-2/3)`` with the distance x behind the lee face, rising
+linearly over the roof from the upwind face, its wake turbulence used to at most 15 R from the
+upwind face). Here: a point in a deck's shadow along the mean wind, at or below its top, is in
+its wake; under the deck the gusts' gain rises from 1 at the upwind edge to
+``wake_gust_gain`` at the lee edge (in proportion to the way across), behind it
+``1 + (wake_gust_gain - 1) ((x + R) / R)^(-2/3)`` up to 15 R behind the lee edge,
+R = ``min(H, W)^(2/3) max(H, W)^(1/3)``, H the deck's thickness and W its width across the
+wind (each at most 8 times the other, Wilson's limits as PRIME applies them); the gain is
+applied to all three components (PRIME gives it for sigma_v and sigma_w). The mean speed
+behind the deck is the free stream's (PRIME's deficit is not modelled there); under it the
+shelter above. So the turbulence intensity (gust sigma over the mean speed) rises under and
+behind a deck: for the default deck in a west wind, 1.7 times the free stream's just behind
+the lee edge, 1.35 / 0.36 = 3.8 times mid-way under it.
 """
 
 from __future__ import annotations
