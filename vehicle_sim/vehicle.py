@@ -66,8 +66,9 @@ class Vehicle:
         self.send = send
         # a spawned child depends on its index only: each added one leaves the earlier as they were
         seeds = np.random.SeedSequence([seed, identity.instance]).spawn(6)
-        gnss_rng, camera_rng, self.rng_motion, _, wind, drift = map(rng, seeds)
-        self.kinematics = vehicle_motion(world, self.home, wind, drift)
+        gnss_rng, camera_rng, self.rng_motion, _, _, drift = map(rng, seeds)
+        # the wind is the run's, the same field in every vehicle: from the seed alone
+        self.kinematics = vehicle_motion(world, self.home, seed, drift)
         flying = scenario.vehicle.dynamics == "multicopter"  # its rims and frame strike things
         body = ContactBody.of(scenario.vehicle.multicopter) if flying else None
         proximity = StructureProximity(world.structure)
@@ -199,7 +200,7 @@ class Vehicle:
             fly_mission(self)
         start, start_s = self.kinematics.truth.copy(), self.sim_time_s
         if self.armed and hasattr(self.kinematics, "set_wind"):  # a multicopter feels it
-            self.kinematics.set_wind(self._wind_now())
+            self.kinematics.set_wind(self._wind_now(), self.sim_time_s)
         if self.armed:
             self.kinematics.step(
                 step_s,

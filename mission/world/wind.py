@@ -1,46 +1,54 @@
-"""The wind a flying vehicle feels around the bridge: a mean wind, shaped by the
-structure, with Dryden turbulence.
+"""The wind a flying vehicle feels around the bridge: a mean wind growing with height, shaped by
+the structure, plus the run's one field of Dryden turbulence (:mod:`mission.world.turbulence`),
+raised in a deck's wake.
 
-**The field** (:class:`WindField`) is crude and says so: no flow is solved. A box of the
-structure that does not touch the ground is a deck, one that does is a pier. Under a deck
-(inside its footprint, below its underside) the wind is sheltered, a wake: the local speed is
-``shelter + (1 - shelter) exp(-d / edge_width_m)`` of the free stream, d the horizontal
+**The mean wind** follows the log law, ``U(z) = W20 ln(z / z0) / ln(h20 / z0)``, W20 the
+scenario's speed at h20 = 20 ft (6.1 m), z0 ``roughness_length_m`` (EN 1991-1-4's table 4.1:
+0.003 m sea, 0.01 m lakes and flat land, 0.05 m grass, 0.3 m villages), held at its value at
+10 ft (3.05 m, MIL-F-8785C's lowest height; EN 1991-1-4 holds it below z_min, 1-5 m for those
+categories). The direction is the free stream's everywhere.
+
+**The structure** is crude and says so: no flow is solved. A box that does not touch the
+ground is a deck, one that does is a pier; a structure from a mesh file shapes nothing. Under
+a deck (inside its footprint, below its underside) the mean speed is sheltered:
+``shelter + (1 - shelter) exp(-d / edge_width_m)`` of the free stream's, d the horizontal
 distance in from the footprint's nearest edge. Around a deck's edges (outside the footprint,
-within ``edge_width_m`` of it horizontally and of its height band vertically) and around the
-piers (within ``edge_width_m`` of one horizontally, below the deck) the flow speeds up past
-the bluff body: ``edge_gain`` times the free stream. Elsewhere the free stream. The direction
-is the free stream's everywhere. A structure from a mesh file shapes nothing (no boxes).
+within ``edge_width_m`` of it horizontally and of its height band vertically, not in its lee)
+and around the piers (within ``edge_width_m`` of one horizontally, below the deck) the flow
+speeds up past the bluff body: mean and gusts ``edge_gain`` times the free stream's.
 
-**The turbulence** (:class:`DrydenGusts`) is MIL-F-8785C's low-altitude Dryden model (as
-RotorPy's ``DrydenGust`` and MATLAB's Dryden block use it), per axis along the mean wind,
-across it and vertically: intensity ``sigma_w = turbulence x 0.1 x W20`` with
-``sigma_u = sigma_v = sigma_w / (0.177 + 0.000823 h)^0.4`` and scale lengths
-``L_u = L_v = h / (0.177 + 0.000823 h)^1.2``, ``L_w = h`` (h in feet, at least 10 ft),
-``W20`` the mean speed at 20 ft (the scenario's speed), the frozen turbulence carried past at
-the mean speed (at least 0.5 m/s). Shaping filters
-``H_u = sigma_u sqrt(2 L_u / (pi V)) / (1 + (L_u / V) s)`` and
-``H_v,w = sigma sqrt(L / (pi V)) (1 + sqrt(3) (L / V) s) / (1 + (L / V) s)^2``, discretised
-(zero-order hold) at the integration rate and driven by seeded white noise, a block of samples
-by a few matrix products (the same numbers as scipy's ``lfilter`` to rounding); each vehicle has
-its own draw, so gusts are not correlated between vehicles. The gust scales with the local
-speed (the shelter calms it, the edges strengthen it).
+**The wake** raises the turbulence: PRIME's building-wake model (Schulman, Strimaitis and
+Scire 2000, J. Air & Waste Manage. Assoc. 50:378-390; EPA AERMOD's ``prime.f``: the wake's
+sigma_v and sigma_w 1.7 times the ambient ones at the lee face, Weil 1996, its speed deficit
+0.7, both fading as ``((x + R) / R)^(-2/3)`` with the distance x behind the lee face, rising
+linearly over the roof from the upwind face, its wake turbulence used to at most 15 R from the
+upwind face). Here: a point in a deck's shadow along the mean wind, at or below its top, is in
+its wake; under the deck the gusts' gain rises from 1 at the upwind edge to
+``wake_gust_gain`` at the lee edge (in proportion to the way across), behind it
+``1 + (wake_gust_gain - 1) ((x + R) / R)^(-2/3)`` up to 15 R behind the lee edge,
+R = ``min(H, W)^(2/3) max(H, W)^(1/3)``, H the deck's thickness and W its width across the
+wind (each at most 8 times the other, Wilson's limits as PRIME applies them); the gain is
+applied to all three components (PRIME gives it for sigma_v and sigma_w). The mean speed
+behind the deck is the free stream's (PRIME's deficit is not modelled there); under it the
+shelter above. So the turbulence intensity (gust sigma over the mean speed) rises under and
+behind a deck: for the default deck in a west wind, 1.7 times the free stream's just behind
+the lee edge, 1.35 / 0.36 = 3.8 times mid-way under it.
 """
 
 from __future__ import annotations
 
-import functools
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from mission.config.settings import BoxPrimitive
 from mission.config.wind_settings import WindSettings
+from mission.world.turbulence import FEET, REFERENCE_HEIGHT_M, DrydenScales, FrozenTurbulence
 
-FEET = 0.3048
-MIN_HEIGHT_FT = 10.0
-MIN_SPEED_M_S = 0.5
-BLOCK = 256  # gust samples filtered at once
+PROFILE_FLOOR_M = 10 * FEET  # the mean wind is held below this height
+WAKE_DECAY = 2.0 / 3.0  # PRIME: turbulence and deficit fade as ((x + R) / R)^(-2/3)
+WAKE_REACH_R = 15.0  # PRIME's xbyrmax: the wake's turbulence used out to 15 R
+WILSON_ASPECT = 8.0  # R's height and width each at most 8 times the other
 
 
 def blowing_toward(from_deg: float) -> np.ndarray:
@@ -55,183 +63,146 @@ def _horizontal_gap(box: BoxPrimitive, x: float, y: float) -> float:
     return math.hypot(max(x0 - x, 0, x - x1), max(y0 - y, 0, y - y1))
 
 
+def _upwind_span(box: BoxPrimitive, x: float, y: float, along: np.ndarray) -> tuple[float, float]:
+    """How far upwind of (x, y), on its line along the wind, the box's footprint begins and
+    ends: its lee edge, then its windward edge (negative: downwind); (inf, -inf) if the line
+    misses it."""
+    low, high = -math.inf, math.inf
+    for point, start, end, direction in zip((x, y), box.min_m, box.max_m, along):
+        if abs(direction) < 1e-12:
+            if not start <= point <= end:
+                return math.inf, -math.inf
+            continue
+        a, b = (point - start) / direction, (point - end) / direction
+        low, high = max(low, min(a, b)), min(high, max(a, b))
+    return (low, high) if low <= high else (math.inf, -math.inf)
+
+
+def wake_scale(deck: BoxPrimitive, along: np.ndarray) -> float:
+    """PRIME's wake length R of a deck in a wind blowing along ``along``: its thickness and
+    its width across the wind, each at most 8 times the other."""
+    (x0, y0, z0), (x1, y1, z1) = deck.min_m, deck.max_m
+    height = z1 - z0
+    width = (x1 - x0) * abs(along[1]) + (y1 - y0) * abs(along[0])
+    height, width = min(height, WILSON_ASPECT * width), min(width, WILSON_ASPECT * height)
+    return min(height, width) ** (2 / 3) * max(height, width) ** (1 / 3)
+
+
 class WindField:
-    """The mean wind at a point (ENU, m/s) and the factor the structure puts on it."""
+    """The mean wind at a point (ENU, m/s) and what the structure does to it and its gusts."""
 
     def __init__(self, settings: WindSettings, boxes: list[BoxPrimitive]) -> None:
         self.settings = settings
-        self.free_stream = settings.speed_m_s * blowing_toward(settings.from_deg)
+        self.boxes = boxes  # what the field was made from, to make it again
+        self.along = blowing_toward(settings.from_deg)
+        self.free_stream = settings.speed_m_s * self.along  # at 6 m (W20's height)
         self.decks = [b for b in boxes if b.min_m[2] > 0]
         self.piers = [b for b in boxes if b.min_m[2] <= 0]
+        self.wake_scales = [wake_scale(deck, self.along) for deck in self.decks]
+
+    def speed_at(self, height_m: float) -> float:
+        """The free stream's mean speed at ``height_m`` (the log law)."""
+        z0 = self.settings.roughness_length_m
+        held = max(height_m, PROFILE_FLOOR_M)
+        return self.settings.speed_m_s * math.log(held / z0) / math.log(REFERENCE_HEIGHT_M / z0)
+
+    def mean(self, point: np.ndarray) -> np.ndarray:
+        """The mean wind at ``point`` (ENU, m/s)."""
+        return self.factor(point) * self.speed_at(float(point[2])) * self.along
 
     def factor(self, point: np.ndarray) -> float:
-        """The local speed over the free stream's at ``point``."""
+        """The local mean speed over the free stream's at ``point``'s height."""
+        return self.shaping(point)[0]
+
+    def gust_gain(self, point: np.ndarray) -> float:
+        """The local gusts' sigma over the free stream's at ``point``."""
+        return self.shaping(point)[1]
+
+    def shaping(self, point: np.ndarray) -> tuple[float, float]:
+        """What the structure does at ``point``: (the mean speed's factor, the gusts')."""
         s = self.settings
         x, y, z = (float(v) for v in point)
-        for deck in self.decks:
+        for deck, scale in zip(self.decks, self.wake_scales):
             (x0, y0, z0), (x1, y1, z1) = deck.min_m, deck.max_m
+            wake = self._wake(deck, scale, x, y, z)
+            gain = 1 + (s.wake_gust_gain - 1) * wake
             inside = x0 <= x <= x1 and y0 <= y <= y1
             if inside and z < z0:
                 depth = min(x - x0, x1 - x, y - y0, y1 - y)
-                return s.shelter + (1 - s.shelter) * math.exp(-depth / s.edge_width_m)
+                return s.shelter + (1 - s.shelter) * math.exp(-depth / s.edge_width_m), gain
+            if wake > 0:
+                return 1.0, gain
             if (
                 not inside
                 and _horizontal_gap(deck, x, y) <= s.edge_width_m
                 and z0 - s.edge_width_m <= z <= z1 + s.edge_width_m
             ):
-                return s.edge_gain
+                return s.edge_gain, s.edge_gain
         for pier in self.piers:
             if _horizontal_gap(pier, x, y) <= s.edge_width_m and z <= pier.max_m[2]:
-                return s.edge_gain
-        return 1.0
+                return s.edge_gain, s.edge_gain
+        return 1.0, 1.0
 
-
-def _expm(matrix: np.ndarray) -> np.ndarray:
-    """exp(matrix) by scaling and squaring a Taylor series (small, well-scaled matrices: the
-    shaping filters' over one substep; numpy only, so a vehicle does not import scipy)."""
-    norm = float(np.abs(matrix).sum(axis=1).max())
-    squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0 else 0
-    scaled = matrix / 2.0**squarings
-    term = result = np.eye(len(matrix))
-    for k in range(1, 20):
-        term = term @ scaled / k
-        result = result + term
-    for _ in range(squarings):
-        result = result @ result
-    return result
-
-
-@dataclass(frozen=True, eq=False)  # hashed by identity: its blocks are cached per filter
-class ShapingFilter:
-    """One axis's shaping filter, discretised (zero-order hold): x' = A x + B u, y = C x,
-    u unit white noise samples, y gust samples (m/s)."""
-
-    a: np.ndarray  # (n, n)
-    b: np.ndarray  # (n,)
-    c: np.ndarray  # (n,)
-
-    @classmethod
-    def of(cls, a: np.ndarray, b: np.ndarray, c: np.ndarray, dt_s: float) -> ShapingFilter:
-        """The continuous filter (a, b, c) held over samples ``dt_s`` apart."""
-        n = len(a)
-        augmented = np.zeros((n + 1, n + 1))
-        augmented[:n, :n], augmented[:n, n] = a, b
-        held = _expm(augmented * dt_s)
-        return cls(held[:n, :n], held[:n, n], np.asarray(c, dtype=float))
-
-    @functools.cache  # noqa: B019 - a handful of filters per process, each kept for its run
-    def block(self, count: int) -> tuple[np.ndarray, ...]:
-        """For ``count`` samples at once: the outputs' response to the state (count, n) and to
-        the inputs (count, count: lower triangular), the state's to the state (n, n) and to
-        the inputs (n, count)."""
-        powers = [np.eye(len(self.a))]
-        for _ in range(count):
-            powers.append(powers[-1] @ self.a)
-        free = np.array([self.c @ power for power in powers[:count]])
-        markov = np.array([0.0] + [self.c @ power @ self.b for power in powers[: count - 1]])
-        lags = np.subtract.outer(np.arange(count), np.arange(count))
-        forced = np.where(lags >= 0, markov[np.clip(lags, 0, None)], 0.0)
-        inputs = np.column_stack([powers[count - 1 - j] @ self.b for j in range(count)])
-        return free, forced, powers[count], inputs
-
-
-def dryden_filters(
-    speed_m_s: float, height_m: float, turbulence: float, dt_s: float
-) -> list[ShapingFilter]:
-    """The three axes' discrete shaping filters: along the mean wind, across it, up; each
-    turns unit white noise samples into gust samples (m/s)."""
-    v = max(speed_m_s, MIN_SPEED_M_S)
-    h_ft = max(height_m / FEET, MIN_HEIGHT_FT)
-    sigma_w = turbulence * 0.1 * speed_m_s
-    sigma_uv = sigma_w / (0.177 + 0.000823 * h_ft) ** 0.4
-    length_uv = h_ft / (0.177 + 0.000823 * h_ft) ** 1.2 * FEET
-    length_w = h_ft * FEET
-    filters = []
-    for axis, (sigma, length) in enumerate(
-        [(sigma_uv, length_uv), (sigma_uv, length_uv), (sigma_w, length_w)]
-    ):
-        tau = length / v
-        if axis == 0:  # K / (tau s + 1)
-            gain = sigma * math.sqrt(2 * length / (math.pi * v))
-            realised = (np.array([[-1 / tau]]), np.array([1.0]), np.array([gain / tau]))
-        else:  # K (sqrt(3) tau s + 1) / (tau s + 1)^2, in controllable canonical form
-            gain = sigma * math.sqrt(length / (math.pi * v))
-            a = np.array([[0.0, 1.0], [-1 / tau**2, -2 / tau]])
-            c = np.array([gain / tau**2, gain * math.sqrt(3) / tau])
-            realised = (a, np.array([0.0, 1.0]), c)
-        filters.append(ShapingFilter.of(*realised, dt_s))
-    return filters
-
-
-class DrydenGusts:
-    """One vehicle's turbulence: gust samples (ENU, m/s) at a fixed rate, continuing from one
-    call to the next, from its own seeded generator."""
-
-    def __init__(
-        self,
-        settings: WindSettings,
-        height_m: float,
-        dt_s: float,
-        rng: np.random.Generator,
-    ) -> None:
-        self.dt_s = dt_s
-        self.rng = rng
-        self.filters = dryden_filters(settings.speed_m_s, height_m, settings.turbulence, dt_s)
-        self.state = [np.zeros(len(f.a)) for f in self.filters]
-        along = blowing_toward(settings.from_deg)
-        across = np.array([-along[1], along[0], 0.0])
-        self.axes = np.column_stack([along, across, [0.0, 0.0, 1.0]])
-        # discrete white noise whose spectrum matches the continuous unit one-sided density
-        self.noise_scale = math.sqrt(math.pi / dt_s)
-
-    def samples(self, count: int) -> np.ndarray:
-        """(count, 3): the next ``count`` gust vectors (filtered a block of at most
-        ``BLOCK`` samples at a time: a few matrix products, no loop over samples)."""
-        noise = self.rng.standard_normal((3, count)) * self.noise_scale
-        gusts = np.empty((3, count))
-        for start in range(0, count, BLOCK):
-            stop = min(start + BLOCK, count)
-            for axis, shaping in enumerate(self.filters):
-                free, forced, carry, inputs = shaping.block(stop - start)
-                u, x = noise[axis, start:stop], self.state[axis]
-                gusts[axis, start:stop] = free @ x + forced @ u
-                self.state[axis] = carry @ x + inputs @ u
-        return (self.axes @ gusts).T
+    def _wake(self, deck: BoxPrimitive, scale: float, x: float, y: float, z: float) -> float:
+        """How strong the deck's wake is at (x, y, z), 0 to 1: across the footprint from the
+        upwind edge, then fading behind the lee edge (module docstring)."""
+        if z > deck.max_m[2]:
+            return 0.0
+        lee, windward = _upwind_span(deck, x, y, self.along)
+        if windward < 0 or lee > WAKE_REACH_R * scale:
+            return 0.0  # upwind of the deck, beside its shadow, or past its wake's reach
+        if lee > 0:  # behind the deck
+            return ((lee + scale) / scale) ** -WAKE_DECAY
+        chord = windward - lee
+        return windward / chord if chord > 0 else 1.0
 
 
 class VehicleWind:
-    """The wind one vehicle flies through: the field's local factor at its position times the
-    free stream plus its gusts, one vector per substep."""
+    """The wind one vehicle flies through: the mean wind at its position, shaped by the
+    structure, plus the run's gusts there, one vector per substep; it keeps the field's clock
+    (the vehicle sets it to the simulated time before each step)."""
 
     def __init__(
-        self, field: WindField, gusts: DrydenGusts, boxes: list[BoxPrimitive], height_m: float
+        self, field: WindField, gusts: FrozenTurbulence | None, seed: int, dt_s: float
     ) -> None:
         self.field = field
-        self.gusts = gusts
-        self.boxes = boxes  # what the field was made from, to make it again
-        self.height_m = height_m
+        self.gusts = gusts  # None: no turbulence (still air, or none asked for)
+        self.seed = seed
+        self.dt_s = dt_s
+        self.time_s = 0.0  # the simulated time of the next substep
 
     @classmethod
     def of(
-        cls,
-        settings: WindSettings,
-        boxes: list[BoxPrimitive],
-        height_m: float,
-        dt_s: float,
-        rng: np.random.Generator,
+        cls, settings: WindSettings, boxes: list[BoxPrimitive], dt_s: float, seed: int
     ) -> VehicleWind:
-        """A vehicle's wind, its gusts' scale lengths set by its height."""
-        gusts = DrydenGusts(settings, height_m, dt_s, rng)
-        return cls(WindField(settings, boxes), gusts, boxes, height_m)
+        """A vehicle's wind in the run of ``seed``, sampled every ``dt_s``."""
+        scales = DrydenScales.of(settings.speed_m_s, settings.turbulence)
+        gusts = None
+        if scales.sigma_w > 0:
+            carried = settings.speed_m_s * blowing_toward(settings.from_deg)
+            gusts = FrozenTurbulence.of(seed, scales, carried)
+        return cls(WindField(settings, boxes), gusts, seed, dt_s)
+
+    def blowing(self, settings: WindSettings) -> VehicleWind:
+        """The same run's wind (its field from the same seed) with other settings, at the
+        same time: the field is where the new mean wind would have carried it by now."""
+        changed = VehicleWind.of(settings, self.field.boxes, self.dt_s, self.seed)
+        changed.time_s = self.time_s
+        return changed
 
     def mean_at(self, position: np.ndarray) -> np.ndarray:
-        """The mean wind at ``position`` (ENU, m/s): no gusts, no draw."""
-        return self.field.factor(position) * self.field.free_stream
+        """The mean wind at ``position`` (ENU, m/s), no gusts."""
+        return self.field.mean(np.asarray(position, dtype=float).reshape(3))
 
     def over_step(self, position: np.ndarray, count: int) -> np.ndarray:
         """(count, 3): the wind at ``position`` over the next ``count`` substeps (still air:
-        zeros, and no draw)."""
+        zeros)."""
+        start_s, self.time_s = self.time_s, self.time_s + count * self.dt_s
         if self.field.settings.speed_m_s == 0:
             return np.zeros((count, 3))
-        factor = self.field.factor(position)
-        return factor * (self.field.free_stream + self.gusts.samples(count))
+        point = np.asarray(position, dtype=float).reshape(3)
+        factor, gain = self.field.shaping(point)
+        mean = factor * self.field.speed_at(float(point[2])) * self.field.along
+        if self.gusts is None:
+            return np.tile(mean, (count, 1))
+        return mean + gain * self.gusts.over_step(point, start_s, self.dt_s, count)

@@ -248,6 +248,30 @@ BAD_INPUTS = [
         "[1, 2]",
     ),
     (
+        "no roughness",
+        "world: {wind: {roughness_length_m: 0}}\n",
+        "world.wind.roughness_length_m",
+        "(0, 0.3]",
+    ),
+    (
+        "a roughness that is not a number",
+        "world: {wind: {roughness_length_m: .nan}}\n",
+        "world.wind.roughness_length_m",
+        "must be finite",
+    ),
+    (
+        "a wake that calms the gusts",
+        "world: {wind: {wake_gust_gain: 0.5}}\n",
+        "world.wind.wake_gust_gain",
+        "raises the turbulence",
+    ),
+    (
+        "an infinite wake gain",
+        "world: {wind: {speed_m_s: 5, wake_gust_gain: .inf}}\n",
+        "world.wind.wake_gust_gain",
+        "must be finite",
+    ),
+    (
         "zone offset 1e9 m",
         "world: {zones: [{name: z, min_m: [-14, -12, 5], max_m: [-4, -6, 11],"
         " offset_m: [1.0e+9, 0, 0]}]}\n",

@@ -138,7 +138,7 @@ def test_a_hovering_quadrotor_holds_its_place_in_gusts_that_push_it():
     # 3 m/s with its gusts: within what it can hold (acceleration_max_m_s2 x m / k = 7.5 m/s)
     gusty = replace(scenario.world.wind, speed_m_s=3.0)
     home = np.array([0.0, 12.0, 6.0])  # in the open, north of the deck
-    flown = Multicopter.at(home, VEHICLE, STEP_S, gusty, [], np.random.default_rng(9))
+    flown = Multicopter.at(home, VEHICLE, STEP_S, gusty, [], 9)
     flown.hold()
     track = [flown.truth]
     for _ in range(120):  # a minute
@@ -146,7 +146,7 @@ def test_a_hovering_quadrotor_holds_its_place_in_gusts_that_push_it():
         track.append(flown.truth)
     drift = np.linalg.norm(np.array(track) - home, axis=1)
     assert 0.02 < drift.max() < 0.5  # pushed about, never far
-    again = Multicopter.at(home, VEHICLE, STEP_S, gusty, [], np.random.default_rng(9))
+    again = Multicopter.at(home, VEHICLE, STEP_S, gusty, [], 9)
     again.hold()
     for _ in range(120):
         again.step(STEP_S, 3.0, np.random.default_rng(0), 0.0)

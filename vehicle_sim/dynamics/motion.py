@@ -12,11 +12,11 @@ from vehicle_sim.dynamics.kinematics import Kinematics
 
 
 def vehicle_motion(
-    world: World, home: np.ndarray, wind_rng: np.random.Generator, drift_rng: np.random.Generator
+    world: World, home: np.ndarray, wind_seed: int, drift_rng: np.random.Generator
 ) -> Any:
     """The motion of a vehicle hovering at ``home``: a :class:`Kinematics`, or a
     :class:`~vehicle_sim.dynamics.multicopter.Multicopter` (imported only then: casadi is no
-    small import for a vehicle that does not need it)."""
+    small import for a vehicle that does not need it) in the wind of the run's ``wind_seed``."""
     scenario = world.scenario
     if scenario.vehicle.dynamics == "multicopter":
         from mission.world.surfaces import VerticalSurfaces
@@ -28,7 +28,7 @@ def vehicle_motion(
             scenario.control.t_cont_s,
             scenario.world.wind,
             list(world.structure.boxes),
-            wind_rng,
+            wind_seed,
             drift_rng,
             VerticalSurfaces(world.structure),
         )

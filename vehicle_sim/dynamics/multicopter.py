@@ -9,9 +9,10 @@ each VISION_POSITION_ESTIMATE sets (the estimate's error, as the kinematic model
 between estimates the belief follows the vehicle by its navigation filter's velocity, the true
 one plus a bias (per run and axis) and noise (per step): the offset drifts.
 ``vehicle.tracking_noise_m`` still kicks the true position each step, as in the kinematic
-model. The wind (:mod:`mission.world.wind`) is sampled at the vehicle's true position at the
-start of each step, one vector a substep; so are the surfaces above and below each rotor (the
-ceiling and ground effects: :mod:`mission.world.surfaces`), held over the step.
+model. The wind (:mod:`mission.world.wind`: the run's one turbulence field, the same in every
+vehicle) is sampled at the vehicle's true position at the start of each step, one vector a
+substep at the simulated time; so are the surfaces above and below each rotor (the ceiling and
+ground effects: :mod:`mission.world.surfaces`), held over the step.
 
 It starts hovering in trim: its velocity loop's integral already holds off the mean wind's
 drag where it is, as that of a vehicle that took off in the wind and climbed there would.
@@ -98,31 +99,32 @@ class Multicopter:
         step_s: float,
         wind: WindSettings | None = None,
         boxes: list[BoxPrimitive] | None = None,
-        rng: np.random.Generator | None = None,
+        wind_seed: int | None = None,
         drift_rng: np.random.Generator | None = None,
         surfaces: VerticalSurfaces | None = None,
     ) -> Multicopter:
         """A quadrotor hovering at ``home`` that knows where it is, in ``wind`` around the
-        structure's ``boxes`` (its gusts drawn from ``rng``), or in still air; its belief
+        structure's ``boxes`` (its gusts the field of the run's ``wind_seed``), or in still
+        air; its belief
         drifting between estimates by the filter's velocity error (drawn from ``drift_rng``),
         or not at all; its rotors' thrust changed by the ``surfaces`` near them, or by
         none."""
         loop = ClosedLoop(vehicle.multicopter, vehicle.autopilot, step_s)
         home = np.asarray(home, dtype=float).reshape(3)
         weather = None
-        if wind is not None and rng is not None:
-            dt = step_s / loop.substeps
-            weather = VehicleWind.of(wind, boxes or [], float(home[2]), dt, rng)
+        if wind is not None and wind_seed is not None:
+            weather = VehicleWind.of(wind, boxes or [], step_s / loop.substeps, wind_seed)
         return cls(loop, home, weather, drift_rng, surfaces)
 
-    def set_wind(self, settings: WindSettings) -> None:
-        """The wind from now on: the same as before, or a new one (its gusts start afresh from
-        the same generator; still air without a generator)."""
-        if self.wind is None or settings == self.wind.field.settings:
+    def set_wind(self, settings: WindSettings, now_s: float | None = None) -> None:
+        """The wind from now on: the same as before, or a new one (the same run's field; still
+        air without one), its clock at the simulated time ``now_s`` (None: where it was)."""
+        if self.wind is None:
             return
-        self.wind = VehicleWind.of(
-            settings, self.wind.boxes, self.wind.height_m, self.wind.gusts.dt_s, self.wind.gusts.rng
-        )
+        if settings != self.wind.field.settings:
+            self.wind = self.wind.blowing(settings)
+        if now_s is not None:
+            self.wind.time_s = now_s
 
     @property
     def truth(self) -> np.ndarray:
