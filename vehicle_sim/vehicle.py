@@ -82,6 +82,7 @@ class Vehicle:
         self.failsafe = False
         self.last_setpoint_s = 0.0
         self.last_warning = ("", -math.inf)  # the last warning said, and when
+        self._wind_said: tuple[tuple[float, float, float], WindSettings] | None = None
         self._text_id = 0  # the last id of a STATUSTEXT sent in chunks
         self.last_estimate_usec: dict[tuple[int, int], int] = {}  # per sender: the last taken
         self.last_setpoint_seen: dict[tuple[int, int], tuple] = {}  # per sender: stamp, content
@@ -216,13 +217,21 @@ class Vehicle:
         self.faults.apply_due(self.sim_time_s)
 
     def _wind_now(self) -> WindSettings:
-        """The scenario's wind as SIM_WIND_SPD, _DIR and _DRYDEN say it is now."""
+        """The scenario's wind as SIM_WIND_SPD, _DIR and _DRYDEN say it is now (made again
+        only when one of them has changed)."""
         value = self.params.table.value
+        said = tuple(value(name) for name in ("SIM_WIND_SPD", "SIM_WIND_DIR", "SIM_WIND_DRYDEN"))
+        if self._wind_said is None or self._wind_said[0] != said:
+            self._wind_said = (said, self._wind_of(said))
+        return self._wind_said[1]
+
+    def _wind_of(self, said: tuple[float, float, float]) -> WindSettings:
+        speed, from_deg, turbulence = said
         return replace(
             self.scenario.world.wind,
-            speed_m_s=value("SIM_WIND_SPD"),
-            from_deg=value("SIM_WIND_DIR") % 360,
-            turbulence=value("SIM_WIND_DRYDEN"),
+            speed_m_s=speed,
+            from_deg=from_deg % 360,
+            turbulence=turbulence,
         )
 
     def _report(self, contacts: list[Contact]) -> None:

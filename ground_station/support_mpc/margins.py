@@ -23,9 +23,9 @@ import math
 
 import numpy as np
 
-from ground_station.support_mpc.casadi_buffer import BufferedFunction
 from ground_station.support_mpc.margin_spaces import SpaceRules, half_spaces_function
 from ground_station.support_mpc.nlp_cache import compiled_function
+from mission.codegen.casadi_buffer import BufferedFunction
 from mission.config.settings import ControlSettings
 from mission.world.proximity import StructureProximity
 from mission.world.structure import Structure

@@ -36,8 +36,8 @@ import casadi as ca
 import numpy as np
 
 from ground_station.estimation.gnss_map import inlined_hermite
-from ground_station.support_mpc.casadi_buffer import BufferedFunction
 from ground_station.support_mpc.nlp_cache import NlpBuild, compiled_libraries
+from mission.codegen.casadi_buffer import BufferedFunction
 from mission.config.settings import ControlSettings
 from mission.world.grid import VoxelGrid
 
