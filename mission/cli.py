@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from mission.commands import analyze, batch, bench, plan, run, study, view, world
+from mission.commands import analyze, batch, bench, plan, run, study, vehicle, view, world
 from mission.procs.command_line import OneLineArgumentParser, program_name, run_guarded
 
-COMMANDS = (world, plan, analyze, view, bench, run, batch, study)  # in --help's order
+COMMANDS = (world, vehicle, plan, analyze, view, bench, run, batch, study)  # in --help's order
 
 
 def build_parser() -> OneLineArgumentParser:

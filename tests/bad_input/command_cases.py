@@ -93,6 +93,11 @@ COMMAND_CASES = [
         ["--plot", "must end in .png or .pdf or .svg"],
     ),
     (
+        "responses-plot-suffix",  # mission vehicle (a "vehicle-" case is vehicle_sim's)
+        lambda t: ["vehicle", "--plot", str(t / "out" / "v.jpg")],
+        ["--plot", "must end in .png or .pdf or .svg"],
+    ),
+    (
         "scenario-name",
         lambda t: [*RUN, "nowhere-scenario"],
         ["nowhere-scenario", "no such scenario (embedded ones:"],
