@@ -32,6 +32,7 @@ from vehicle_sim.dynamics.contact import Contact, ContactDetector, ContactWatch,
 from vehicle_sim.dynamics.motion import vehicle_motion
 from vehicle_sim.mavlink import modes, streams, telemetry
 from vehicle_sim.mavlink.auto_mission import fly_mission
+from vehicle_sim.mavlink.guidance import fence_moving_target
 from vehicle_sim.mavlink.incoming import HANDLERS
 from vehicle_sim.mavlink.mission_server import MissionServer
 from vehicle_sim.mavlink.param_server import ParamServer
@@ -117,7 +118,15 @@ class Vehicle:
             capacity=vs.mission_capacity,
         )
         table = vehicle_parameters(self.scenario, self.speed_limit_m_s, speedup, link_loss)
-        return mission, ParamServer(table, self.send, self.notify, self._parameter_set)
+        params = ParamServer(table, self.send, self.notify, self._parameter_set, self._veto)
+        return mission, params
+
+    def _veto(self, name: str, value: float) -> str | None:
+        """Why a flying vehicle's loops could not take ``value`` for PX4 parameter ``name``
+        with the others as they are (a kinematic point takes any in range)."""
+        if name in PX4_PARAMETERS and hasattr(self.kinematics, "tuning_problem"):
+            return self.kinematics.tuning_problem(PX4_PARAMETERS[name], value)
+        return None
 
     def _parameter_set(self, name: str, value: float, source: str = "Set") -> None:
         """A parameter set live takes effect before the next step, and is said. Most are read
@@ -203,6 +212,7 @@ class Vehicle:
         if self.armed and hasattr(self.kinematics, "set_wind"):  # a multicopter feels it
             self.kinematics.set_wind(self._wind_now(), self.sim_time_s)
         if self.armed:
+            fence_moving_target(self.world, self.kinematics, step_s)
             self.kinematics.step(
                 step_s,
                 self.speed_limit_m_s,

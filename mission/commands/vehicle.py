@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -30,6 +31,11 @@ def add_parser(commands) -> None:
     parser.set_defaults(handler=vehicle)
 
 
+def _finite(seconds: float) -> float | None:
+    """A time for JSON: rounded, or None where it never settles (inf is not JSON)."""
+    return None if math.isinf(seconds) else round(seconds, 2)
+
+
 def vehicle(args: argparse.Namespace) -> int:
     """``mission vehicle``: the responses' numbers as one JSON object, and the figure."""
     if args.plot is not None:
@@ -48,8 +54,8 @@ def vehicle(args: argparse.Namespace) -> int:
             "design": round(float(step.design_m.max()) - 1.0, 4),
         },
         "step_settling_2cm_s": {
-            "model": round(settling_s(step.times_s, step.model_m, 1.0, BAND_M), 2),
-            "design": round(settling_s(step.times_s, step.design_m, 1.0, BAND_M), 2),
+            "model": _finite(settling_s(step.times_s, step.model_m, 1.0, BAND_M)),
+            "design": _finite(settling_s(step.times_s, step.design_m, 1.0, BAND_M)),
         },
         "step_tilt_max_deg": round(float(step.tilt_deg.max()), 2),
         "gust_displacement_max_m": {
@@ -57,8 +63,8 @@ def vehicle(args: argparse.Namespace) -> int:
             "design": round(float(gust.design_m.max()), 4),
         },
         "gust_settling_2cm_s": {
-            "model": round(settling_s(gust.times_s, gust.model_m, 0.0, BAND_M), 2),
-            "design": round(settling_s(gust.times_s, gust.design_m, 0.0, BAND_M), 2),
+            "model": _finite(settling_s(gust.times_s, gust.model_m, 0.0, BAND_M)),
+            "design": _finite(settling_s(gust.times_s, gust.design_m, 0.0, BAND_M)),
         },
     }
     json.dump(numbers, sys.stdout)

@@ -61,7 +61,6 @@ class AutopilotSettings:
         _non_negative(self, "velocity_integral_gain_per_s2", "vertical_integral_gain_per_s2")
         _non_negative(self, "velocity_derivative_gain", "thrust_min", "thrust_xy_margin")
         _at_most(self, 0.5, "a share of the rotors' thrust", "thrust_min")
-        _at_most(self, 0.9, "a share of the rotors' thrust", "thrust_xy_margin")
         _require(
             MIN_TILT_DEG <= self.tilt_max_deg <= MAX_TILT_DEG,
             "tilt_max_deg",

@@ -22,9 +22,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import Any
 
-from mission.config.autopilot_settings import AutopilotSettings
+from mission.config.autopilot_settings import PX4_PARAMETERS, AutopilotSettings
 from mission.config.checks import require
+from mission.config.errors import FieldProblem
 from mission.config.multicopter_settings import STANDARD_GRAVITY, MulticopterSettings
 
 MAX_RATE_HZ = 2000.0
@@ -104,3 +108,18 @@ def _check_rotors(body: MulticopterSettings) -> None:
         "must be at most rotor_thrust_max_n x lever_m (a propeller's drag torque is a few per "
         "cent of its thrust's moment)",
     )
+
+
+def check_fault_tunings(faults: Sequence[Any], vehicle: Any) -> None:
+    """A fault that sets a flying vehicle's PX4 gain leaves loops it can fly (each fault
+    against the scenario's other settings); FieldProblem naming ``faults[i].value``."""
+    if vehicle.dynamics != "multicopter":
+        return
+    for i, fault in enumerate(faults):
+        field = PX4_PARAMETERS.get(str(fault.param))
+        if field is None or fault.value is None:
+            continue
+        try:
+            check_flyable(vehicle.multicopter, replace(vehicle.autopilot, **{field: fault.value}))
+        except FieldProblem as problem:
+            raise FieldProblem(f"faults[{i}].value", problem.problem) from None

@@ -40,7 +40,7 @@ from mission.config.proximity_laws import ground_gain_denominator
 MIN_RATE_HZ = 50.0  # below this the motors' 0.05 s lag is not resolved
 STANDARD_GRAVITY = 9.80665
 MAX_MASS_KG = 100.0
-# rotor angles from the nose toward the left (PX4's quad X: front-right first)
+# rotor angles from the nose toward the left: front-left, rear-left, rear-right, front-right
 ROTOR_ANGLES_DEG = (45.0, 135.0, 225.0, 315.0)
 ProximityModel = Literal["measured", "image", "none"]
 PROXIMITY_MODELS = get_args(ProximityModel)
@@ -133,8 +133,8 @@ class MulticopterSettings:
 
     def rotor_hubs(self) -> np.ndarray:
         """(4, 3): each rotor's hub in the body frame (FLU, m): at (+-L, +-L), L the lever,
-        ``rotor_height_m`` above the centre of mass, at 45, 135, 225 and 315 degrees from the
-        nose."""
+        ``rotor_height_m`` above the centre of mass; front-left, rear-left, rear-right,
+        front-right."""
         angles = np.radians(ROTOR_ANGLES_DEG)
         arm, height = self.rotor_arm_m, np.full(4, self.rotor_height_m)
         return np.column_stack([arm * np.cos(angles), arm * np.sin(angles), height])

@@ -18,6 +18,7 @@ from mission.config.checks import positive as _positive
 from mission.config.checks import require as _require
 from mission.config.errors import FieldProblem
 from mission.config.fault_settings import Fault, check_faults
+from mission.config.flight_checks import check_fault_tunings
 from mission.config.integrity_settings import IntegritySettings
 from mission.config.limit_settings import LimitSettings
 from mission.config.planner_vehicle_settings import PlannerSettings, VehicleSettings
@@ -357,6 +358,7 @@ class Scenario:
             )
         self._check_margins()
         self._check_integrity()
+        check_fault_tunings(self.faults, self.vehicle)
         check_faults(self.faults, self.task.supports, self.run.timeout_s, self.control.t_cont_s)
         check_waypoints(self.task, self.world.workspace, self.control.clearance_m)
         check_roles(self.roles, self.task.supports, self.control.arrival_tol_m)

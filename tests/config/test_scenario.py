@@ -297,6 +297,13 @@ BAD_INPUTS = [
         "infinite",
     ),
     (
+        "a fault setting a gain the loops could not fly",
+        "vehicle: {dynamics: multicopter}\n"
+        "faults: [{at_s: 5, vehicle: work, param: MPC_XY_P, value: 1.5}]\n",
+        "faults[0].value",
+        "below velocity_gain_per_s",
+    ),
+    (
         "a negative rotor radius",
         "vehicle: {multicopter: {rotor_radius_m: -0.1}}\n",
         "vehicle.multicopter.rotor_radius_m",

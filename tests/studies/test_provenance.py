@@ -34,12 +34,13 @@ def made(tmp_path):
 
 def test_the_canary_runs_first_and_its_digest_is_the_provenances(made):
     study, engine = made
-    assert [folder.split("-ac-")[0] for folder in engine.ran[:3]] == [
+    assert [folder.split("-ac-")[0] for folder in engine.ran[:4]] == [
         "canary-along-0",
         "canary-piers-1",
         "canary-along-2",
+        "canary-piers-3",
     ]
-    assert not any(folder.startswith("canary") for folder in engine.ran[3:])
+    assert not any(folder.startswith("canary") for folder in engine.ran[4:])
     provenance = read_provenance(study)
     digests = [f"canary-{c.scenario}-{n}-{n}-ac-0" for n, c in enumerate(CANARY)]
     expected = hashlib.sha256(json.dumps(digests).encode()).hexdigest()[:16]

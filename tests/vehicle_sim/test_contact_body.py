@@ -41,8 +41,8 @@ def test_the_bounding_radius_defaults_to_the_rotor_tips():
 
 
 def test_a_rotor_tip_striking_a_pier_face_is_contact(detector):
-    # level, nose east: the front rotors' rims reach lever + rotor radius = 0.327 m ahead;
-    # beside the pier's east face with the tips 1 cm into it, and 5 cm short of it
+    # level, nose east, east of the pier: the rear rotors' rims reach lever + rotor radius =
+    # 0.327 m behind; beside the pier's east face with the tips 1 cm into it, and clear of it
     reach = BODY.lever_m + BODY.rotor_radius_m
     struck = _held_at(detector, np.array([PIER_FACE_X + reach - 0.01, 0.0, 4.0]))
     clear = _held_at(detector, np.array([PIER_FACE_X + reach + TOLERANCE + 0.01, 0.0, 4.0]))

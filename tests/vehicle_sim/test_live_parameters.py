@@ -259,3 +259,20 @@ def test_a_px4_speed_limit_set_live_slows_a_multicopter(along_world):
     refused.params.handle(mavlink2.MAVLink_param_set_message(2, 1, b"MPC_TILTMAX_AIR", 95.0, kind))
     assert refused.params.table.value("MPC_TILTMAX_AIR") == 45.0  # out of range: refused
     assert refused.kinematics.settings.tilt_max_deg == 45.0  # and the loops untouched
+
+
+def test_a_gain_the_loops_could_not_fly_is_refused_live(along_world):
+    from dataclasses import replace
+
+    from mission.world.model import World
+
+    scenario = along_world.scenario
+    flying = World(replace(scenario, vehicle=replace(scenario.vehicle, dynamics="multicopter")))
+    vehicle = _vehicle(flying, np.array([0.0, 12.0, 6.0]))
+    kind = mavlink2.MAV_PARAM_TYPE_REAL32
+    # in MPC_XY_P's range, but above the velocity loop's 1.8 / 1.5: the loops would couple
+    vehicle.params.handle(mavlink2.MAVLink_param_set_message(2, 1, b"MPC_XY_P", 1.5, kind))
+    assert vehicle.params.table.value("MPC_XY_P") == 0.95
+    assert vehicle.kinematics.settings.position_gain_per_s == 0.95
+    _set(vehicle, "MPC_XY_P", 1.1)  # within: taken
+    assert vehicle.kinematics.settings.position_gain_per_s == 1.1

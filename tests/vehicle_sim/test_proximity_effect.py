@@ -44,11 +44,12 @@ def test_the_measured_ceiling_law_is_its_formula_at_five_distances(radii):
     assert ceiling_gain(BODY, radii * R) == pytest.approx(_hsiao(radii * R), rel=1e-12)
 
 
-def test_the_measured_ceiling_law_gives_the_published_gains():
-    # 1.10 at R, 1.37 at R / 2, 2.32 at R / 4 (the last inside the default clip: unclipped)
+def test_the_measured_ceiling_law_gives_the_gains_quoted_for_it():
+    # about 1.10 at R, 1.37 at R / 2 and 2.3 at R / 4 (the last inside the default clip:
+    # unclipped), the values quoted for the measured laws
     unclipped = replace(BODY, proximity_clip_radii=0.1, ground_model="none")
     gains = [ceiling_gain(unclipped, k * R) for k in (1.0, 0.5, 0.25)]
-    assert gains == pytest.approx([1.0977, 1.3708, 2.3247], abs=1e-4)
+    assert gains == pytest.approx([1.10, 1.37, 2.3], abs=0.03)
 
 
 @pytest.mark.parametrize("height_radii", [3.0, 1.0, 0.5])

@@ -99,6 +99,14 @@ def test_the_tilt_reaches_its_limit_before_the_speed_does(loop):
     at_speed = next(i for i, s in enumerate(speeds) if s > 0.9 * LOOPS.horizontal_speed_max_m_s)
     assert at_tilt < at_speed
     assert max(tilts) < LOOPS.tilt_max_deg + 1.0  # and it is a limit
+    # the configured one: MPC_TILTMAX_AIR at 30 degrees caps the same move there
+    tuning = np.array(LOOPS.tuning())
+    tuning[TUNED_FIELDS.index("tilt_max_deg")] = math.radians(30.0)
+    state, tilts = _start(), []
+    for _ in range(30):
+        state, _ = loop.advance(state, target, np.zeros(3), 12.0, np.zeros(3), tuning=tuning)
+        tilts.append(_tilt_deg(state[ATTITUDE]))
+    assert 29.0 < max(tilts) < 31.0
 
 
 def _commands_function():

@@ -79,3 +79,19 @@ def test_a_setpoint_it_cannot_take_is_refused_and_said(along_world, mask, veloci
     text = "".join(m.text for m in sent if m.get_type() == "STATUSTEXT")  # chunks, in order
     assert text.startswith("Setpoint rejected") and said in text
     assert vehicle.kinematics.target is None or np.allclose(vehicle.kinematics.target, HOME)
+
+
+def test_a_setpoints_velocity_is_held_to_the_speed_limit_and_stops_at_the_fence(along_world):
+    vehicle, _ = _guided(along_world)
+    limit = vehicle.speed_limit_m_s
+    _send(vehicle, position_target(HOME, 0, 2, np.array([0.0, 10.0 * limit, 0.0])))
+    assert np.linalg.norm(vehicle.kinematics.target_velocity) == pytest.approx(limit)
+    # north toward the deck (its south face at y = -5, from z 8): the target moving at 1 m/s
+    # stops short of it rather than carry the vehicle in
+    below_deck = np.array([0.0, -6.2, 8.5])  # beside the deck, level with it
+    vehicle, _ = _guided(along_world)
+    _send(vehicle, position_target(below_deck, 0, 2, np.array([0.0, 1.0, 0.0])))
+    for _ in range(3):
+        vehicle.step()
+    assert vehicle.kinematics.target_velocity is None
+    assert vehicle.kinematics.target[1] < -5.0

@@ -4,7 +4,7 @@ vehicle's body.
 Each step's motion is a path: a point's straight segment, or a flying body's poses at its
 substeps joined by straight legs. Against the structure and the ground the body is a sphere of
 ``vehicle.radius_m`` (a kinematic vehicle), or a flying quadrotor's rotor rims and frame at
-its attitude (:mod:`~vehicle_sim.dynamics.contact_body`); the path is sampled every quarter
+its attitude (:mod:`~mission.world.contact_body`); the path is sampled every quarter
 radius, or every :data:`BODY_SPACING_M` for a quadrotor's points (a body cannot pass through a
 deck between samples). Against another vehicle the two straight motions of the centres over
 the same interval give their exact closest approach

@@ -26,6 +26,8 @@ from dataclasses import replace
 import numpy as np
 
 from mission.config.autopilot_settings import AutopilotSettings
+from mission.config.errors import FieldProblem
+from mission.config.flight_checks import check_flyable
 from mission.config.planner_vehicle_settings import VehicleSettings
 from mission.config.settings import BoxPrimitive
 from mission.config.wind_settings import WindSettings
@@ -85,10 +87,20 @@ class Multicopter:
     def _pose(self) -> np.ndarray:
         return np.concatenate([self.state[POSITION], self.state[ATTITUDE]])
 
+    def tuning_problem(self, field: str, value: float) -> str | None:
+        """Why the loops could not fly with ``field`` (an :class:`AutopilotSettings` field) at
+        ``value``, the rest as they are: the settings' own checks and the flight checks a
+        scenario's pass (None: they could)."""
+        try:
+            check_flyable(self.loop.body, replace(self.settings, **{field: value}))
+        except FieldProblem as problem:
+            return problem.problem
+        return None
+
     def tune(self, field: str, value: float) -> None:
-        """Set one of the loops' tunable values (an :class:`AutopilotSettings` field) from the
-        next step on; FieldProblem (naming the field) where the loops could not take it."""
-        self.settings = replace(self.settings, **{field: value})  # validated as the scenario's
+        """Set one of the loops' tunable values from the next step on (one
+        :meth:`tuning_problem` found none for)."""
+        self.settings = replace(self.settings, **{field: value})
         self.tuning = np.array(self.settings.tuning())
 
     @classmethod

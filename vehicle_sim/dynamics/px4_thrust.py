@@ -4,7 +4,7 @@ PositionControl.cpp, ``_velocityControl`` and ``_accelerationControl``, and Cont
 ``limitTilt``), with thrust normalised to [0, 1] of the rotors' total:
 
 1. acceleration setpoint a = Kp e + integral - Kd dv/dt (e = v_sp - v, dv/dt the filtered
-   acceleration);
+   acceleration), the vertical integral held within +-g (and not integrated further out);
 2. thrust direction (a_x, a_y, g) (acceleration and gravity decoupled, PX4's default
    MPC_ACC_DECOUPLE), tilted back to the tilt limit where it leans further;
 3. the vertical thrust T_z = hover (1 + a_z / g), the thrust along the direction
@@ -55,6 +55,8 @@ def thrust_setpoint(
     tilt_max, thr_min, thr_max, margin = limits
     g = STANDARD_GRAVITY
     kp = ca.vertcat(kp_xy, kp_xy, kp_z)
+    held_z = ca.fmin(ca.fmax(integral[2], -g), g)  # PX4 holds the vertical integral within g
+    integral = ca.vertcat(integral[0], integral[1], held_z)
     acceleration = kp * error + integral - damping
     direction = ca.vertcat(acceleration[0], acceleration[1], g)
     direction = limit_tilt(direction / ca.norm_2(direction), tilt_max)
@@ -81,5 +83,8 @@ def thrust_setpoint(
     wanted = acceleration[:2]
     excess = ca.if_else(ca.sumsqr(wanted) > ca.sumsqr(produced), wanted - produced, [0, 0])
     error_xy = error[:2] - 2.0 / kp_xy * excess
-    rate = ca.vertcat(ki_xy * error_xy, ki_z * error_z)
+    outward = ca.logic_or(
+        ca.logic_and(held_z >= g, error_z > 0), ca.logic_and(held_z <= -g, error_z < 0)
+    )
+    rate = ca.vertcat(ki_xy * error_xy, ca.if_else(outward, 0, ki_z * error_z))
     return thrust, rate

@@ -1,8 +1,9 @@
 """Which position targets a guided vehicle accepts: the message's own form, then the fence.
 
 A target is a position, or a position and a velocity (ArduPilot's GUIDED takes both: the
-target then moves on at that velocity, which the autopilot also feeds forward, until the next
-setpoint or the failsafe). Acceleration, force, yaw and yaw rate are not taken."""
+target then moves on at that velocity, at most the vehicle's speed limit, which the autopilot
+also feeds forward, until the next setpoint, the failsafe, or the fence: a target that would
+move outside it stops where it is). Acceleration, force, yaw and yaw rate are not taken."""
 
 from __future__ import annotations
 
@@ -50,11 +51,16 @@ def setpoint_problem(msg: Any, guided: bool) -> tuple[str, str] | None:
     return None
 
 
-def setpoint_velocity(msg: Any) -> np.ndarray | None:
-    """The velocity (ENU) of an accepted setpoint, None for a position-only one."""
+def setpoint_velocity(msg: Any, speed_limit_m_s: float) -> np.ndarray | None:
+    """The velocity (ENU) of an accepted setpoint, no faster than the vehicle's speed limit;
+    None for a position-only one."""
     if int(msg.type_mask) & VELOCITY_BITS:
         return None
-    return ned_to_enu(np.array([msg.vx, msg.vy, msg.vz], dtype=float))
+    velocity = ned_to_enu(np.array([msg.vx, msg.vy, msg.vz], dtype=float))
+    speed = float(np.linalg.norm(velocity))
+    if speed > speed_limit_m_s * (1 + 1e-9):  # a plan's own speed passes untouched
+        velocity *= speed_limit_m_s / speed
+    return velocity
 
 
 def geofence_problem(
@@ -72,3 +78,13 @@ def geofence_problem(
     ):
         return "geofence", "fence: crosses structure"
     return None
+
+
+def fence_moving_target(world: KnownWorld, kinematics: Any, step_s: float) -> None:
+    """A target moving at its setpoint's velocity stops where it is if the step would take it
+    outside the fence (the vehicle then holds it)."""
+    if kinematics.target is None or kinematics.target_velocity is None:
+        return
+    ahead = kinematics.target + kinematics.target_velocity * step_s
+    if geofence_problem(world, kinematics.target, ahead) is not None:
+        kinematics.target_velocity = None

@@ -54,7 +54,7 @@ def on_setpoint(vehicle: Any, msg: Any) -> None:
         warn_once(vehicle, f"Setpoint rejected: {detail}")
         return
     kinematics.target = target
-    kinematics.target_velocity = setpoint_velocity(msg)
+    kinematics.target_velocity = setpoint_velocity(msg, vehicle.speed_limit_m_s)
     vehicle.last_setpoint_s = vehicle.sim_time_s
     if vehicle.failsafe:
         vehicle.failsafe = False

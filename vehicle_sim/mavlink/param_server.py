@@ -28,12 +28,16 @@ class ParamServer:
         send: Callable[[Any], None],
         notify: Callable[[int, str], None],
         on_change: Callable[[str, float], None],
+        veto: Callable[[str, float], str | None] | None = None,
     ) -> None:
-        """``on_change(name, value)`` applies and announces a value once it is set."""
+        """``on_change(name, value)`` applies and announces a value once it is set; ``veto``
+        (name, value) says why a value in the parameter's range cannot be taken with the
+        others as they are (None: it can)."""
         self.table = table
         self._send = send
         self._notify = notify
         self._on_change = on_change
+        self._veto = veto
 
     def handle(self, msg: Any) -> bool:
         """Act on ``msg`` if it is a parameter message (True), else leave it (False)."""
@@ -59,6 +63,8 @@ class ParamServer:
             return
         name = self.table[index].name
         refusal = self.table.refusal(index, float(msg.param_value), int(msg.param_type))
+        if refusal is None and self._veto is not None:
+            refusal = self._veto(name, float(msg.param_value))
         if refusal is None:
             value = float(msg.param_value)
             self.table.set(index, value)
