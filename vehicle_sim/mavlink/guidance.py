@@ -20,6 +20,7 @@ ACCELERATION_BITS = 0b0000_0001_1100_0000  # ignored, always
 VELOCITY_BITS = 0b0000_0000_0011_1000  # all ignored, or none
 POSITION_BITS = 0b0000_0000_0000_0111
 MAX_SETPOINT_SPEED_M_S = 50.0
+SPEED_ROUNDING = 1e-5  # a velocity sent as float32 at the speed limit arrives ~5e-7 over it
 FORCE_BIT = 0b0000_0010_0000_0000
 MAX_ABS_COORD_M = 100_000.0
 
@@ -58,7 +59,7 @@ def setpoint_velocity(msg: Any, speed_limit_m_s: float) -> np.ndarray | None:
         return None
     velocity = ned_to_enu(np.array([msg.vx, msg.vy, msg.vz], dtype=float))
     speed = float(np.linalg.norm(velocity))
-    if speed > speed_limit_m_s * (1 + 1e-9):  # a plan's own speed passes untouched
+    if speed > speed_limit_m_s * (1 + SPEED_ROUNDING):  # a plan's own speed passes untouched
         velocity *= speed_limit_m_s / speed
     return velocity
 
