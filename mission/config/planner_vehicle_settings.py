@@ -53,8 +53,9 @@ class VehicleSettings:
     """
 
     tracking_noise_m: float
-    radius_m: float | None  # None: the default for the dynamics (:func:`body_radius`); a
-    # number once built
+    radius_m: float | None  # None: the default for the dynamics (:func:`body_radius`), a
+    # number once built (``dataclasses.replace`` of the dynamics keeps that number: load the
+    # scenario with the override to get the other default)
     failsafe_s: float
     heartbeat_hz: float
     status_hz: float

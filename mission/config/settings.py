@@ -252,7 +252,8 @@ class ControlSettings:
     clearance_m: float  # from the structure and the ground over the horizon (0: no margin)
     estimate_allowance_m: float  # the MPCs keep margins this much wider per estimate involved
     tracking_allowance_m: float | None  # ... and this much per vehicle for its tracking error
-    # (None in a scenario: the default for the vehicles' dynamics, set by the Scenario)
+    # (None in a scenario: the default for the vehicles' dynamics, set by the Scenario once;
+    # ``dataclasses.replace`` of the dynamics keeps it)
     velocity_feedforward: bool  # flying vehicles get the plan's velocity with its position
 
     def __post_init__(self) -> None:
