@@ -42,7 +42,6 @@ ROLE_LEVELS = {"formation": 0, "inspecting": 1, "returning": 2}  # the roles plo
 G_RANGE_M = (0.0, 1.2)  # G's colour scale (values above show as the top colour)
 G_CHANGED_M = 0.01  # a voxel is shown once G differs from its initial value by this much
 
-UAV_RADIUS_M = 0.6
 ESTIMATE_RADIUS_M = 0.3
 FIX_RADIUS_M = 0.12
 ROLE_RADIUS_M = 0.2

@@ -27,6 +27,7 @@ class Scene:
     voxel_origin: np.ndarray
     voxel_m: float
     wind: np.ndarray  # the free stream (ENU, m/s); zeros in still air
+    body_radius_m: float = 0.25  # a UAV drawn as its bounding body (vehicle.radius_m)
     inspections: dict[str, np.ndarray] = field(default_factory=dict)  # a support's own, (n, 3)
     # the true GNSS error field where the multipath comes from geometry: voxel indices (n, 3)
     # and |error| there (n,), the voxels above GNSS_ERROR_SHOWN_M only; None with zones
@@ -54,6 +55,7 @@ def build_scene(scenario: Scenario, world: World) -> Scene:
         voxel_origin=np.array(grid.origin_m, dtype=float),
         voxel_m=float(grid.voxel_m),
         wind=WindField(scenario.world.wind, []).free_stream,
+        body_radius_m=scenario.vehicle.radius_m,
         inspections={i.vehicle: np.array(i.waypoints_m) for i in scenario.task.inspections},
         gnss_error=gnss_error_voxels(world),
     )

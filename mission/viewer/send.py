@@ -9,8 +9,7 @@ import rerun as rr
 from mission.viewer import frame as f
 from mission.viewer.scene import Scene
 
-_POINT_RADII = {
-    "uav": f.UAV_RADIUS_M,
+_POINT_RADII = {  # a UAV's own is its body's (the scene's)
     "estimate": f.ESTIMATE_RADIUS_M,
     "gnss": f.FIX_RADIUS_M,
     "role": f.ROLE_RADIUS_M,
@@ -131,7 +130,8 @@ def _send_wind(rec: rr.RecordingStream, scene: Scene) -> None:
 def send_frame(rec: rr.RecordingStream, frame: f.Frame, scene: Scene) -> None:
     """A frame's rows, entity by entity."""
     for path, rows in frame.points.items():
-        radius = _POINT_RADII.get(path.split("/", 1)[0], 0.3)
+        kind = path.split("/", 1)[0]
+        radius = scene.body_radius_m if kind == "uav" else _POINT_RADII.get(kind, 0.3)
         radii = rows.radii or [radius] * len(rows.times)
         columns = rr.Points3D.columns(
             positions=np.array(rows.values, dtype=float).reshape(-1, 3),
