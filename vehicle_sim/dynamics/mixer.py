@@ -26,7 +26,7 @@ import casadi as ca
 import numpy as np
 
 from mission.config.multicopter_settings import MulticopterSettings
-from vehicle_sim.dynamics.rigid_body import ROTOR_SPINS, rotor_offsets
+from vehicle_sim.dynamics.rigid_body import ROTOR_SPINS
 
 YAW_MARGIN = 0.15  # PX4's MINIMUM_YAW_MARGIN
 
@@ -35,7 +35,7 @@ def allocation(body: MulticopterSettings) -> np.ndarray:
     """(4, 4): the rotors' thrusts (N) from [collective thrust (N), roll, pitch and yaw
     moments (N m)]: the inverse of what the thrusts make."""
     per_thrust = body.rotor_torque_max_n_m / body.rotor_thrust_max_n
-    offsets = rotor_offsets(body)
+    offsets = body.rotor_hubs()
     columns = [[1.0, y, -x, -spin * per_thrust] for (x, y, _), spin in zip(offsets, ROTOR_SPINS)]
     return np.linalg.inv(np.array(columns).T)
 

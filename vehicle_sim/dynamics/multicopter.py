@@ -44,7 +44,6 @@ from vehicle_sim.dynamics.rigid_body import (
     VELOCITY,
     hover_drag,
     resting_state,
-    rotor_offsets,
 )
 
 CALM = np.zeros(3)
@@ -65,7 +64,7 @@ class Multicopter:
         self.wind = wind  # None: still air
         # None, or no proximity effect in the body: nothing near changes the thrust
         self.surfaces = surfaces if loop.body.proximity_effects else None
-        self.rotors = rotor_offsets(loop.body)
+        self.rotors = loop.body.rotor_hubs()
         loops = loop.loops
         self.drift_rng = drift_rng  # None: the belief moves with the truth exactly
         self.velocity_bias = (

@@ -63,16 +63,11 @@ def rotation(q: ca.SX) -> ca.SX:
     )
 
 
-def rotor_offsets(settings: MulticopterSettings) -> np.ndarray:
-    """(4, 3): each rotor's hub in the body frame (FLU, m)."""
-    return settings.rotor_hubs()
-
-
 def near_surfaces(settings: MulticopterSettings, state: ca.SX, surfaces: ca.SX) -> ca.SX:
     """(4,) each rotor's thrust gain under the surface above it and over the one below
     (``surfaces``: the four rotors' heights above, then below)."""
     s = settings
-    heights = state[2] + (rotation(state[ATTITUDE]) @ ca.DM(rotor_offsets(s).T))[2, :].T
+    heights = state[2] + (rotation(state[ATTITUDE]) @ ca.DM(s.rotor_hubs().T))[2, :].T
     above = ceiling_gain(s, surfaces[:4] - heights, ca.fmax)
     below = ground_gain(s, heights - surfaces[4:], ca.fmax)
     return above * below
@@ -87,7 +82,7 @@ def air_forces(settings: MulticopterSettings, state: ca.SX, wind: ca.SX) -> tupl
     drag = -ca.norm_2(air) * ca.DM(s.parasitic_drag_n_s2_m2) * air
     moment = ca.DM.zeros(3)
     in_plane = ca.DM([s.rotor_drag_coefficient, s.rotor_drag_coefficient, 0.0])
-    for hub, thrust in zip(rotor_offsets(s), ca.vertsplit(thrusts)):
+    for hub, thrust in zip(s.rotor_hubs(), ca.vertsplit(thrusts)):
         speed = ca.sqrt(ca.fmax(thrust, 0) / s.rotor_thrust_coefficient)
         hub_force = -speed * in_plane * (air + ca.cross(rates, ca.DM(hub)))
         drag += hub_force
@@ -119,7 +114,7 @@ def derivative(
     torque_per_thrust = s.rotor_torque_max_n_m / s.rotor_thrust_max_n
     moment -= s.rotational_damping_n_m_per_rad_s * rates
     for (arm_x, arm_y, _), spin, lift, thrust in zip(
-        rotor_offsets(s), ROTOR_SPINS, ca.vertsplit(lifting), ca.vertsplit(thrusts)
+        s.rotor_hubs(), ROTOR_SPINS, ca.vertsplit(lifting), ca.vertsplit(thrusts)
     ):
         # the lever's moment (r x F for F along body z) and the reaction to the rotor's spin
         moment += ca.vertcat(arm_y * lift, -arm_x * lift, -spin * torque_per_thrust * thrust)
