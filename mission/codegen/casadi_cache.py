@@ -26,6 +26,7 @@ from pathlib import Path
 
 import casadi as ca
 
+from mission.codegen.lean_gradient import LEAN, generate_solver_functions, wants_lean_gradient
 from mission.codegen.news import Compiling
 
 # -O1: as fast a solve as -O2 (1,220 recorded solves, bit-identical results) and the
@@ -53,12 +54,16 @@ class NlpBuild:
         nlp = self.nlp
         functions = ca.Function("nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
         options = repr(sorted(self.options.items()))
-        return "\n".join([self.name, self.plugin, options, functions.serialize()])
+        lean = [LEAN] if wants_lean_gradient(self.options) else []
+        return "\n".join([self.name, self.plugin, options, *lean, functions.serialize()])
 
     def generate(self, source: str) -> None:
         """Write the C of the functions the solver evaluates to ``source`` (working directory)."""
         solver = ca.nlpsol(self.name, self.plugin, self.nlp, self.options)
-        solver.generate_dependencies(source)
+        if wants_lean_gradient(self.options):
+            generate_solver_functions(solver, self.nlp, self.options, source)
+        else:
+            solver.generate_dependencies(source)
 
 
 @dataclass(frozen=True)
