@@ -137,12 +137,12 @@ class TerminalBranches:
         if form.endswith(SOFT):  # the slacks start at each step's violation of its margins
             slacks = self.margins.slack_guess(guess, self._margin_flags(flags))
             x0 = np.concatenate([x0, slacks + 1e-3])
-        result = solver(
+        result, converged = solver.solve(
             x0=x0,
             p=np.concatenate([fixed, [weight], flags]),
             ubg=self.upper_bounds[form],
         )
-        status = solver.stats()["unified_return_status"]
+        status = CONVERGED if converged else solver.stats()["unified_return_status"]
         path = result["x"][: 3 * self.horizon].reshape(self.horizon, 3)
         terminal_sq = float(np.sum((self.terminal_of(fixed) - path[-1]) ** 2))
         cost = float(result["f"][0]) + (self._xi_weight(terminal_sq) - weight) * terminal_sq

@@ -54,6 +54,7 @@ IPOPT_OPTIONS = {
     # MUMPS's matching-based permutation and scaling are for hard large systems; here they
     # cost 5 % of a solve and change the solutions by 1e-14 (600 recorded problems)
     "ipopt.mumps_permuting_scaling": 0,
+    "error_on_fail": True,  # a failure raises (caught): a success needs no look at stats()
 }
 # fatrop runs IPOPT's algorithm (filter line search, same barrier defaults) without IPOPT's
 # per-solve set-up of its objects and of MUMPS, which is ~90 % of a 15-variable solve: 3x
@@ -62,6 +63,7 @@ FATROP_OPTIONS = {
     "structure_detection": "none",
     "print_time": False,
     "calc_lam_p": False,
+    "error_on_fail": True,  # a failure raises (caught): a success needs no look at stats()
     # bound_push as IPOPT's warm start has it: the guess is the previous plan, shifted
     "fatrop": {"print_level": 0, "tol": 1e-4, "max_iter": 50, "bound_push": 1e-3},
 }
