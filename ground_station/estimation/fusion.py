@@ -76,10 +76,8 @@ class FusionResult:
 
     def log_p(self, x: np.ndarray) -> np.ndarray:
         """log P(x) up to the constant alpha: sum over S of log f(x; mu_n, Sigma_n)."""
-        return sum(
-            (density(np.atleast_2d(x)) for density in self.densities),
-            start=np.zeros(len(np.atleast_2d(x))),
-        )
+        x = np.atleast_2d(x)
+        return sum(iter(log_densities(self.densities, x)), start=np.zeros(len(x)))
 
 
 @dataclass(frozen=True)
@@ -99,8 +97,17 @@ class LogDensity:
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """log N(x; mu, sigma) for rows of x."""
-        z = np.linalg.solve(self.factor, (x - self.mu).T)
-        return -0.5 * (np.sum(z * z, axis=0) + self.log_det + 3 * np.log(2 * np.pi))
+        return log_densities((self,), x)[0]
+
+
+def log_densities(densities: tuple[LogDensity, ...] | list[LogDensity], x: np.ndarray):
+    """(k, n): each density's log N at the rows of x, the k triangular systems solved in one
+    call (each as it is alone: the same values)."""
+    factors = np.array([density.factor for density in densities])
+    offsets = np.array([(x - density.mu).T for density in densities])
+    z = np.linalg.solve(factors, offsets)
+    log_det = np.array([density.log_det for density in densities])
+    return -0.5 * (np.sum(z * z, axis=1) + log_det[:, None] + 3 * np.log(2 * np.pi))
 
 
 def fuse(
@@ -144,7 +151,7 @@ def selective_fusion(
         for s in contributing
     ]
     densities = [LogDensity.of(s.mu, s.sigma) for s in contributing]
-    rho = correlation_matrix([density(broad) for density in densities])
+    rho = correlation_matrix(list(log_densities(densities, broad)))
     agree = (rho > settings.rho_threshold).sum(axis=1)
     voters = len(supports) if settings.agreement == "paper" else len(contributing)
     in_s = [i for i, count in enumerate(agree) if count >= voters / 2]
@@ -153,7 +160,7 @@ def selective_fusion(
         in_s = list(range(len(contributing)))
     particles = np.vstack([broad, *local])
     chosen = tuple(densities[i] for i in in_s)
-    score = sum(density(particles) for density in chosen)
+    score = sum(iter(log_densities(chosen, particles)))
     xhat = particles[int(np.argmax(score))]
     consistent = tuple(contributing[i].name for i in in_s)
     return FusionResult(xhat, consistent, names, fallback, rho, chosen)

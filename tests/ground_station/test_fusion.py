@@ -13,6 +13,7 @@ from ground_station.estimation.fusion import (
     LogDensity,
     SupportMeasurement,
     correlation_matrix,
+    log_densities,
     selective_fusion,
     support_feedback,
 )
@@ -91,6 +92,21 @@ def test_the_log_density_matches_scipy():
     np.testing.assert_allclose(
         LogDensity.of(mu, sigma)(x), multivariate_normal(mu, sigma).logpdf(x), rtol=1e-10
     )
+
+
+def test_densities_in_one_call_equal_each_alone_bit_for_bit():
+    rng = np.random.default_rng(2)
+    densities = []
+    for _ in range(4):
+        a = rng.normal(size=(3, 3))
+        densities.append(LogDensity.of(rng.normal(size=3), a @ a.T + 0.1 * np.eye(3)))
+    x = rng.normal(size=(700, 3)) * 5
+    alone = [
+        -0.5 * (np.sum(z * z, axis=0) + d.log_det + 3 * np.log(2 * np.pi))
+        for d in densities
+        for z in [np.linalg.solve(d.factor, (x - d.mu).T)]
+    ]
+    assert np.array_equal(log_densities(densities, x), np.array(alone))
 
 
 def test_correlation_matrix_matches_pearson_on_densities():
