@@ -38,6 +38,7 @@ class LosAnchors:
         self._directions = cube / np.linalg.norm(cube, axis=1, keepdims=True)
         reach = control.horizon_steps * control.d_max_support_m
         self._shell_radii = np.arange(0.5, reach + 1e-9, 0.5)
+        self._first_shell = self._shell_radii[0] * self._directions
 
     def __call__(
         self, guess: np.ndarray, work: np.ndarray, targets: np.ndarray, blocked: np.ndarray
@@ -47,16 +48,24 @@ class LosAnchors:
         anchors = np.array(work, dtype=float)
         if self.control.los_penalty == "paper" or not np.any(blocked):
             return anchors
-        for u in np.flatnonzero(blocked):
-            anchors[u] = self._nearest_visible(guess[u], work[u], targets[u])
+        # Every blocked step and its first shell judged in one evaluation (nine anchors in ten
+        # are found there; a point's verdict does not depend on the points judged with it).
+        steps = np.flatnonzero(blocked)
+        firsts = guess[steps, None] + np.vstack([np.zeros((1, 3)), self._first_shell])[None]
+        sees = self._sees_with_a_fix(
+            firsts.reshape(-1, 3), np.repeat(work[steps], len(firsts[0]), axis=0)
+        ).reshape(len(steps), -1)
+        for u, first, seen in zip(steps, firsts, sees, strict=True):
+            anchors[u] = self._nearest_visible(first, seen, work[u], targets[u])
         return anchors
 
-    def _nearest_visible(self, start: np.ndarray, work: np.ndarray, fallback: np.ndarray):
-        # The step itself, then shell after shell; the step and the first shell are judged in
-        # one evaluation (nine anchors in ten are found there, and a point's verdict does not
-        # depend on the points judged with it).
-        first = np.vstack([start[None], start + self._shell_radii[0] * self._directions])
-        sees = self._sees_with_a_fix(first, work)
+    def _nearest_visible(
+        self, first: np.ndarray, sees: np.ndarray, work: np.ndarray, fallback: np.ndarray
+    ) -> np.ndarray:
+        """The step itself (``first[0]``) if it sees the work UAV, else the nearest seeing
+        point of the first shell (``first[1:]``, judged in ``sees``), then of the next
+        shells."""
+        start = first[0]
         if sees[0]:
             return start
         shells = [(first[1:], sees[1:])]
@@ -73,4 +82,4 @@ class LosAnchors:
         if self.sigma0 is not None:
             sigma = hermite_zero_slope(self.sigma0, self.grid, points)
             usable = sigma <= self.control.support_max_sigma0_m
-        return usable & self.camera.observable(points, work[None])
+        return usable & self.camera.observable(points, np.atleast_2d(work))
