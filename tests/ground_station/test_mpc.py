@@ -325,8 +325,9 @@ def test_supports_stay_out_of_the_structures_gnss_shadow(along_world):
 
 
 def test_anchors_are_the_nearest_visible_points_shell_by_shell(along_world):
-    """The anchor search (step and first shell judged together) returns what judging the step
-    and then each shell on its own returns, for blocked steps all around the bridge."""
+    """The anchor search (every blocked step and its first shell judged together) returns what
+    judging each step and then each shell on its own returns, for blocked steps all around the
+    bridge; a step that sees is anchored at the work UAV."""
     mpc = _with_control(along_world, los_penalty="visible-point")
     control, camera = mpc.control, along_world.camera
 
@@ -346,10 +347,15 @@ def test_anchors_are_the_nearest_visible_points_shell_by_shell(along_world):
     work = np.array([0.0, -3.0, 7.0])  # under the deck's edge
     fallback = np.array([99.0, 99.0, 99.0])
     found_at = set()
-    for _ in range(150):
-        start = np.array([rng.uniform(-15, 15), rng.uniform(-12, 12), rng.uniform(1, 13)])
-        expected = shell_by_shell(start, work, fallback)
-        got = mpc._anchors._nearest_visible(start, work, fallback)
-        np.testing.assert_array_equal(got, expected)
-        found_at.add(round(float(np.linalg.norm(expected - start)), 6))
+    horizon = control.horizon_steps
+    works, fallbacks = np.repeat(work[None], horizon, axis=0), np.full((horizon, 3), 99.0)
+    for _ in range(40):  # a horizon's blocked steps are judged together
+        starts = rng.uniform([-15, -12, 1], [15, 12, 13], (horizon, 3))
+        blocked = rng.random(horizon) < 0.8
+        got = mpc._anchors(starts, works, fallbacks, blocked)
+        for start, anchor, is_blocked in zip(starts, got, blocked, strict=True):
+            expected = shell_by_shell(start, work, fallback) if is_blocked else work
+            np.testing.assert_array_equal(anchor, expected)
+            if is_blocked:
+                found_at.add(round(float(np.linalg.norm(expected - start)), 6))
     assert 0.0 in found_at and len(found_at) > 3  # the step itself, first and further shells
