@@ -21,6 +21,7 @@ import casadi as ca
 import numpy as np
 
 UNUSED_OFFSET = -1.0  # a slot no half-space fills: n = 0, b = -1
+MARGIN_SPACES = "margin_half_spaces"  # the function's name (and its library's part)
 
 
 @dataclass(frozen=True)
@@ -62,7 +63,7 @@ def half_spaces_function(rules: SpaceRules, horizon: int) -> ca.Function:
             offsets.append(b)
     spaces_out = ca.vertcat(*normals, *offsets)
     return ca.Function(
-        "margin_half_spaces",
+        MARGIN_SPACES,
         [guess, yhat, others],
         [spaces_out, inside],
         ["guess", "yhat", "others"],

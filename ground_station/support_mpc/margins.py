@@ -23,8 +23,11 @@ import math
 
 import numpy as np
 
-from ground_station.support_mpc.margin_spaces import SpaceRules, half_spaces_function
-from ground_station.support_mpc.nlp_cache import compiled_function
+from ground_station.support_mpc import margin_spaces
+from ground_station.support_mpc.margin_spaces import MARGIN_SPACES, SpaceRules, half_spaces_function
+from ground_station.support_mpc.nlp_cache import compiled_keyed_function
+from mission.codegen import casadi_cache
+from mission.codegen.build_key import build_key
 from mission.codegen.casadi_buffer import BufferedFunction
 from mission.config.settings import ControlSettings
 from mission.world.proximity import StructureProximity
@@ -33,6 +36,7 @@ from mission.world.structure import Structure
 SLOTS = 3  # half-spaces a step keeps, the nearest to binding at the guess (fewer rows)
 Space = tuple[tuple[float, float, float], float]  # n, b of the half-space n.v >= b
 UNUSED: Space = ((0.0, 0.0, 0.0), -1.0)  # a slot no half-space fills
+MARGIN_SPACES_BUILT_BY = (margin_spaces, casadi_cache)  # what its cache key covers (traced)
 
 
 class Margins:
@@ -67,7 +71,16 @@ class Margins:
         not apply (no margins, or a mesh file among the pieces)."""
         if self.slots == 0 or (self.clearance > 0 and self.proximity.has_file_mesh):
             return None
-        rules = SpaceRules(
+        rules, horizon = self.space_rules(), self._horizon
+        key = build_key([rules, horizon], MARGIN_SPACES_BUILT_BY)
+        function = compiled_keyed_function(
+            MARGIN_SPACES, key, lambda: half_spaces_function(rules, horizon), compiled
+        )
+        return BufferedFunction(function, ("spaces", "inside"))
+
+    def space_rules(self) -> SpaceRules:
+        """What the compiled half-spaces are made of (boxes only)."""
+        return SpaceRules(
             self.separation,
             self.clearance,
             self._reach_m,
@@ -76,8 +89,6 @@ class Margins:
             self.other_slots,
             self.slots,
         )
-        function = half_spaces_function(rules, self._horizon)
-        return BufferedFunction(compiled_function(function, compiled), ("spaces", "inside"))
 
     def parameters(self, guess: np.ndarray, yhat: np.ndarray, others: np.ndarray) -> np.ndarray:
         """The NLP's margin parameters for a guess (U, 3): every step's normals (column by

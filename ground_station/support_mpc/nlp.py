@@ -30,15 +30,21 @@ so the solver gets exact second derivatives.
 from __future__ import annotations
 
 import contextlib
+import functools
+import sys
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
+from ground_station.estimation import gnss_map
 from ground_station.estimation.gnss_map import inlined_hermite
-from ground_station.support_mpc.nlp_cache import NlpBuild, compiled_libraries
+from ground_station.support_mpc.nlp_cache import KeyedBuild, NlpBuild, compiled_libraries
+from mission.codegen import casadi_cache, lean_gradient
+from mission.codegen.build_key import build_key
 from mission.codegen.casadi_buffer import BufferedFunction
 from mission.config.settings import ControlSettings
+from mission.world import grid
 from mission.world.grid import VoxelGrid
 
 IPOPT_OPTIONS = {
@@ -70,6 +76,9 @@ FATROP_OPTIONS = {
 SOLVER_OPTIONS = {"fatrop": FATROP_OPTIONS, "ipopt": IPOPT_OPTIONS}
 MARGIN_WEIGHT = 1.0e4  # cost per metre of a margin's violation (the exact penalty's weight)
 SOFT = "_soft"  # the suffix of a branch's solver with the margins as an exact penalty
+# The code the NLPs' cache key covers: this module, G's interpolant and its grid, and how the
+# C is generated (a test traces the build for any other module of the project it runs).
+NLP_BUILT_BY = (sys.modules[__name__], gnss_map, grid, lean_gradient, casadi_cache)
 
 
 @dataclass(frozen=True)
@@ -166,7 +175,40 @@ def build_support_nlp(
 ) -> SupportNlp:
     """The NLP over a window of voxels with ``slots`` margin half-spaces per step (none: the
     paper's problem), its functions compiled when a C compiler is there (and ``compiled`` asks
-    for it; else casadi interprets them: the same plans, slower)."""
+    for it; else casadi interprets them: the same plans, slower). Compiled libraries are
+    cached under a key from these arguments and the code that builds the NLP
+    (:data:`NLP_BUILT_BY`): a cached one loads without the NLP being built."""
+    symbolic = functools.cache(lambda: _symbolic_nlps(control, window, with_prior, slots))
+    forms = ["near", "far"] + (["near" + SOFT, "far" + SOFT] if slots else [])
+    plugin = control.mpc_solver
+    options = SOLVER_OPTIONS[plugin]
+    key = build_key(
+        [control, window.voxel_m, window.shape, with_prior, slots, plugin, options], NLP_BUILT_BY
+    )
+
+    def build(form: str) -> NlpBuild:
+        return NlpBuild(f"support_mpc_{form}", plugin, symbolic()[0][form], options)
+
+    builds = [
+        KeyedBuild(f"support_mpc_{form}", key, functools.partial(build, form)) for form in forms
+    ]
+    unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
+    interpreted = contextlib.nullcontext([None] * len(builds))
+    with compiled_libraries(builds) if compiled else interpreted as libraries:
+        solvers = {}
+        for form, build_of, library in zip(forms, builds, libraries, strict=True):
+            loaded = symbolic()[0][form] if library is None else library
+            solver = ca.nlpsol(build_of.part, plugin, loaded, options)
+            solvers[form] = BufferedFunction(solver, ("x", "f"), unbounded)
+        # near's own f(x, p) is the cost: compiled, its library's "nlp" (f and g)
+        cost = symbolic()[1] if libraries[0] is None else ca.external("nlp", libraries[0])
+    return SupportNlp(solvers, BufferedFunction(cost, ("f",)))
+
+
+def _symbolic_nlps(
+    control: ControlSettings, window: VoxelGrid, with_prior: bool, slots: int
+) -> tuple[dict[str, dict[str, ca.MX]], ca.Function]:
+    """Each form's NLP (keys x, p, f, g) by name, and the cost as a function of (x, p)."""
     horizon = control.horizon_steps
     s = NlpSymbols.make(horizon, window.n_voxels, with_prior, slots)
     hermite = inlined_hermite(window)  # G_s and the prior's, per step
@@ -200,8 +242,7 @@ def build_support_nlp(
         for branch, g in rows.items():
             name = branch + SOFT if soft else branch
             nlps[name] = {"x": s.variables(soft), "p": parameters, "f": objective, "g": g}
-    solvers = _solvers(control.mpc_solver, nlps, compiled)
-    return SupportNlp(solvers, BufferedFunction(cost_function, ("f",)))
+    return nlps, cost_function
 
 
 def _cost(control: ControlSettings, s: NlpSymbols, hermite: ca.Function) -> ca.MX:
@@ -218,22 +259,3 @@ def _cost(control: ControlSettings, s: NlpSymbols, hermite: ca.Function) -> ca.M
         if u + 1 < horizon:
             cost += c.w_interval * ca.sumsqr(v[:, u + 1] - v[:, u])
     return cost
-
-
-def _solvers(
-    plugin: str, nlps: dict[str, dict[str, ca.MX]], compiled: bool
-) -> dict[str, BufferedFunction]:
-    """One solver per branch, from compiled libraries where a C compiler is there."""
-    options = SOLVER_OPTIONS[plugin]
-    unbounded = {"lbx": -np.inf, "ubx": np.inf, "lbg": -np.inf}
-    builds = [
-        NlpBuild(f"support_mpc_{branch}", plugin, nlp, options) for branch, nlp in nlps.items()
-    ]
-    solvers = {}
-    interpreted = contextlib.nullcontext([None] * len(builds))
-    with compiled_libraries(builds) if compiled else interpreted as libraries:
-        for branch, build, library in zip(nlps, builds, libraries, strict=True):
-            loaded = build.nlp if library is None else library
-            solver = ca.nlpsol(build.name, plugin, loaded, options)
-            solvers[branch] = BufferedFunction(solver, ("x", "f"), unbounded)
-    return solvers

@@ -6,27 +6,30 @@ process each); later runs load the cached libraries and build nothing.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 import casadi as ca
 
 from mission.codegen import casadi_cache
-from mission.codegen.casadi_cache import FunctionBuild, NlpBuild, c_compiler
+from mission.codegen.casadi_cache import Build, FunctionBuild, KeyedBuild, NlpBuild, c_compiler
 from mission.codegen.news import Compiling
 
-__all__ = ["FunctionBuild", "NlpBuild", "c_compiler"]
+__all__ = ["FunctionBuild", "KeyedBuild", "NlpBuild", "c_compiler"]
 
 SUPPORT_MPC = Compiling("ground station", "the support MPC", "support_mpc")
 
 
 @contextmanager
-def compiled_libraries(builds: list[NlpBuild | FunctionBuild]) -> Iterator[list[str | None]]:
+def compiled_libraries(builds: list[Build]) -> Iterator[list[str | None]]:
     """The libraries, in a private scratch folder where the cache cannot take them."""
     with casadi_cache.compiled_libraries(builds, SUPPORT_MPC) as libraries:
         yield libraries
 
 
-def compiled_function(function: ca.Function, compiled: bool = True) -> ca.Function:
-    """``function`` compiled, cached and loaded (itself, interpreted, without a compiler)."""
-    return casadi_cache.compiled_function(function, SUPPORT_MPC, compiled)
+def compiled_keyed_function(
+    name: str, key: str, make: Callable[[], ca.Function], compiled: bool = True
+) -> ca.Function:
+    """``make()``'s function compiled and cached under ``key``: a cache hit loads it without
+    calling ``make()`` (interpreted, ``make()``, without a compiler)."""
+    return casadi_cache.compiled_keyed_function(name, key, make, SUPPORT_MPC, compiled)

@@ -87,8 +87,30 @@ class FunctionBuild:
         self.function.generate(source)
 
 
+@dataclass(frozen=True)
+class KeyedBuild:
+    """A build cached under a key from what it is made of (:mod:`mission.codegen.build_key`):
+    a cached library loads without its expressions being built; ``make()`` builds them only
+    where the library must be compiled."""
+
+    part: str
+    key: str
+    make: Callable[[], NlpBuild | FunctionBuild]
+
+    def recipe(self) -> str:
+        """What the library is made from (its cache key hashes it)."""
+        return "\n".join(["keyed", self.part, self.key])
+
+    def generate(self, source: str) -> None:
+        """Build the expressions and write their C to ``source`` (working directory)."""
+        self.make().generate(source)
+
+
+Build = NlpBuild | FunctionBuild | KeyedBuild
+
+
 def compiled_builds(
-    builds: list[NlpBuild | FunctionBuild], fallback_dir: Callable[[], str], who: Compiling
+    builds: list[Build], fallback_dir: Callable[[], str], who: Compiling
 ) -> list[str | None]:
     """For each build, the functions its casadi solver needs (or the function), compiled into
     a shared library with the system C compiler (about 4x faster plans than interpreting
@@ -98,7 +120,8 @@ def compiled_builds(
     A library is cached (under ``$XDG_CACHE_HOME`` or ``~/.cache``) by the hash of the
     serialised NLP, the solver's name, plugin and options, the casadi version, the compiler
     and its flags: a run after the first builds no solver from the expressions, generates no
-    C and compiles nothing. The C sources are generated in a scratch directory that is gone on
+    C and compiles nothing. A :class:`KeyedBuild` is hashed by its key instead, so a hit does
+    not even build the expressions. The C sources are generated in a scratch directory that is gone on
     return; where the cache cannot be written, the libraries go to ``fallback_dir()``.
     """
     compiler = c_compiler()
@@ -156,7 +179,7 @@ def _turn(prefix: str) -> Iterator[None]:
 
 def _generate_and_compile(
     compiler: str,
-    builds: list[NlpBuild | FunctionBuild],
+    builds: list[Build],
     missing: dict[int, str],
     fallback_dir: Callable[[], str],
     prefix: str,
@@ -186,9 +209,7 @@ def _generate_and_compile(
 
 
 @contextlib.contextmanager
-def compiled_libraries(
-    builds: list[NlpBuild | FunctionBuild], who: Compiling
-) -> Iterator[list[str | None]]:
+def compiled_libraries(builds: list[Build], who: Compiling) -> Iterator[list[str | None]]:
     """:func:`compiled_builds` with a private scratch folder for the libraries the cache cannot
     take, gone on leaving: load them inside. Once casadi has loaded a library its file may go
     (no clean-up is left for the exit, which a forked helper makes with os._exit)."""
@@ -209,12 +230,25 @@ def compiled_function(function: ca.Function, who: Compiling, compiled: bool = Tr
         return function if library is None else ca.external(function.name(), library)
 
 
+def compiled_keyed_function(
+    name: str, key: str, make: Callable[[], ca.Function], who: Compiling, compiled: bool = True
+) -> ca.Function:
+    """The function ``make()`` builds (named ``name``), compiled and cached under ``key``: a
+    cached library loads without ``make()`` being called; interpreted (``make()``) without a
+    C compiler or when ``compiled`` is False."""
+    if not compiled:
+        return make()
+    build = KeyedBuild(name, key, lambda: FunctionBuild(make()))
+    with compiled_libraries([build], who) as (library,):
+        return make() if library is None else ca.external(name, library)
+
+
 def c_compiler() -> str | None:
     """The system C compiler casadi's generated code is compiled with (None: interpreted)."""
     return shutil.which("gcc") or shutil.which("cc")
 
 
-def _library_name(compiler: str, build: NlpBuild | FunctionBuild, prefix: str) -> str:
+def _library_name(compiler: str, build: Build, prefix: str) -> str:
     recipe = f"{ca.__version__} {compiler} {' '.join(COMPILE_FLAGS)}\n{build.recipe()}"
     return f"{prefix}_{hashlib.sha256(recipe.encode()).hexdigest()[:16]}.so"
 
