@@ -106,19 +106,20 @@ def warped_index(u: np.ndarray | ca.MX | ca.SX, upper: np.ndarray) -> np.ndarray
 
 
 _CORNERS = np.array(list(itertools.product((0, 1), repeat=3)))
+_CORNER_IS_HIGH = _CORNERS == 1
 
 
 def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) -> np.ndarray:
     """Zero-slope cubic Hermite interpolation of voxel values at points (numpy)."""
     points = np.atleast_2d(np.asarray(points, dtype=float))
-    shape = np.array(grid.shape)
+    upper, base_cap, last = grid.index_limits
     u = (points - grid.origin_m) / grid.voxel_m - 0.5
-    w = warped_index(u, (shape - 1).astype(float))
-    base = np.minimum(np.floor(w).astype(int), np.maximum(shape - 2, 0))
+    w = warped_index(u, upper)
+    base = np.minimum(np.floor(w).astype(int), base_cap)
     frac = w - base
     # the eight corners at once: (N, 8, 3) indices and per-axis weights
-    index = np.minimum(base[:, None, :] + _CORNERS, shape - 1)
-    factors = np.where(_CORNERS == 1, frac[:, None, :], 1 - frac[:, None, :])
+    index = np.minimum(base[:, None, :] + _CORNERS, last)
+    factors = np.where(_CORNER_IS_HIGH, frac[:, None, :], 1 - frac[:, None, :])
     weight = factors[..., 0] * factors[..., 1] * factors[..., 2]
     terms = weight * values[index[..., 0], index[..., 1], index[..., 2]]
     result = terms[:, 0].copy()

@@ -64,6 +64,7 @@ class Margins:
         ]
         self._horizon = control.horizon_steps
         self._function = self._compiled(compiled)
+        self._radii: dict[tuple[int, float, bool], np.ndarray] = {}  # least_slack's, by reach
 
     def _compiled(self, compiled: bool) -> BufferedFunction | None:
         """The half-spaces as a casadi function (:mod:`ground_station.support_mpc.margin_spaces`),
@@ -188,10 +189,13 @@ class Margins:
         ``from_start``, that starts at ``centre`` (step u within (u + 1) d_max of it): where
         a half-space lies beyond its step's ball, the step must break it by at least the gap."""
         normals, offsets = self._unpack(parameters)
-        horizon = len(offsets)
-        steps = np.arange(1, horizon + 1) if from_start else horizon - np.arange(horizon)
-        radius = steps * d_max * (1 + 1e-6)  # the bounds' tolerance
-        gap = offsets - normals @ np.asarray(centre, dtype=float) - radius[:, None]
+        reach = (len(offsets), d_max, from_start)
+        radius = self._radii.get(reach)
+        if radius is None:
+            horizon = len(offsets)
+            steps = np.arange(1, horizon + 1) if from_start else horizon - np.arange(horizon)
+            radius = self._radii[reach] = (steps * d_max * (1 + 1e-6))[:, None]  # the bounds'
+        gap = offsets - normals @ np.asarray(centre, dtype=float) - radius  # tolerance: 1e-6
         return float(np.maximum(gap.max(axis=1), 0.0).sum())
 
     def slack_guess(self, guess: np.ndarray, parameters: np.ndarray) -> np.ndarray:

@@ -121,8 +121,9 @@ def compiled_builds(
     serialised NLP, the solver's name, plugin and options, the casadi version, the compiler
     and its flags: a run after the first builds no solver from the expressions, generates no
     C and compiles nothing. A :class:`KeyedBuild` is hashed by its key instead, so a hit does
-    not even build the expressions. The C sources are generated in a scratch directory that is gone on
-    return; where the cache cannot be written, the libraries go to ``fallback_dir()``.
+    not even build the expressions. The C sources are generated in a scratch directory that
+    is gone on return; where the cache cannot be written, the libraries go to
+    ``fallback_dir()``.
     """
     compiler = c_compiler()
     libraries: list[str | None] = [None] * len(builds)

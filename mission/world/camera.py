@@ -80,10 +80,13 @@ class CameraModel:
         """True where the target is within range and the sight line misses the structure."""
         observer = np.atleast_2d(np.asarray(observer, dtype=float))
         target = np.atleast_2d(np.asarray(target, dtype=float))
-        distance = np.linalg.norm(target - observer, axis=1)
+        offset = target - observer
+        distance = np.sqrt(np.add.reduce(offset * offset, axis=1))  # np.linalg.norm's sum
         in_range = (distance <= self.settings.range_m) & (distance > 0)
         if self.structure is None:
             return in_range
+        if in_range.all():  # the usual case: every sight line is cast
+            return ~self.structure.segments_blocked(observer, target)
         clear = np.zeros_like(in_range)
         if np.any(in_range):
             observer_b, target_b = np.broadcast_arrays(observer, target)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +24,16 @@ class VoxelGrid:
         size = np.array(box.size_m)
         shape = tuple(max(1, int(np.floor(s / voxel_m + 1e-9))) for s in size)
         return cls(np.array(box.min_m, dtype=float), float(voxel_m), shape)  # type: ignore[arg-type]
+
+    @functools.cached_property
+    def index_limits(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per axis: the highest fractional index, the highest base of an interpolation's
+        cell and the highest index (read-only; the interpolants' bounds, made once)."""
+        size = np.array(self.shape)
+        limits = ((size - 1).astype(float), np.maximum(size - 2, 0), size - 1)
+        for array in limits:
+            array.flags.writeable = False
+        return limits
 
     @property
     def n_voxels(self) -> int:
