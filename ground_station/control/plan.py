@@ -14,7 +14,6 @@ import numpy as np
 
 from ground_station.control.run_context import RunContext
 from ground_station.control.work_mpc import WorkPrediction, hold_work, predict_work
-from ground_station.estimation.gnss_map import hermite_zero_slope
 from ground_station.roles.allocation import routed_plans
 from ground_station.state.station_state import StationState
 from ground_station.support_mpc.mpc import PlanRequest, SupportPlan
@@ -123,8 +122,8 @@ def support_request(
     map expected."""
     yhat = state.yhat[name]
     g = context.g
-    initial = float(hermite_zero_slope(g.initial, g.grid, yhat)[0])
-    risen = bool(g.smoothed(yhat)[0] > initial + ESCAPE_MARGIN_M)
+    now, initial = g.smoothed_with_initial(yhat)
+    risen = bool(now[0] > float(initial[0]) + ESCAPE_MARGIN_M)
     escape = risen and context.scenario.control.escape_starts
     return context.support_mpc.request(
         name,

@@ -78,6 +78,11 @@ class LocalizabilityMap:
         """G_s at points (N, 3), in numpy."""
         return hermite_zero_slope(self.values, self.grid, points)
 
+    def smoothed_with_initial(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """G_s now and as it started (sigma_0's), at points (N, 3)."""
+        now, initial = hermite_zero_slope_of((self.values, self.initial), self.grid, points)
+        return now, initial
+
 
 def learn(
     g: LocalizabilityMap, measurements: Sequence[SupportMeasurement], yhat: dict[str, np.ndarray]
@@ -111,6 +116,14 @@ _CORNER_IS_HIGH = _CORNERS == 1
 
 def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) -> np.ndarray:
     """Zero-slope cubic Hermite interpolation of voxel values at points (numpy)."""
+    return hermite_zero_slope_of((values,), grid, points)[0]
+
+
+def hermite_zero_slope_of(
+    maps: Sequence[np.ndarray], grid: VoxelGrid, points: np.ndarray
+) -> list[np.ndarray]:
+    """:func:`hermite_zero_slope` of several maps over the same grid at the same points, the
+    corners and their weights found once (each map's values as it alone gives them)."""
     points = np.atleast_2d(np.asarray(points, dtype=float))
     upper, base_cap, last = grid.index_limits
     u = (points - grid.origin_m) / grid.voxel_m - 0.5
@@ -121,11 +134,15 @@ def hermite_zero_slope(values: np.ndarray, grid: VoxelGrid, points: np.ndarray) 
     index = np.minimum(base[:, None, :] + _CORNERS, last)
     factors = np.where(_CORNER_IS_HIGH, frac[:, None, :], 1 - frac[:, None, :])
     weight = factors[..., 0] * factors[..., 1] * factors[..., 2]
-    terms = weight * values[index[..., 0], index[..., 1], index[..., 2]]
-    result = terms[:, 0].copy()
-    for corner in range(1, len(_CORNERS)):  # summed in corner order, as the loop it replaces
-        result += terms[:, corner]
-    return result
+    corners = (index[..., 0], index[..., 1], index[..., 2])
+    results = []
+    for values in maps:
+        terms = weight * values[corners]
+        result = terms[:, 0].copy()
+        for corner in range(1, len(_CORNERS)):  # summed in corner order, as the loop it replaced
+            result += terms[:, corner]
+        results.append(result)
+    return results
 
 
 def casadi_hermite(grid: VoxelGrid, x: ca.MX, values: ca.MX) -> ca.MX:
