@@ -34,7 +34,7 @@ from mission.studies.spec import StudySpec, validate_points
 from mission.studies.table3 import write_tables
 
 REPORT_EVERY_S = 60.0  # the report and its figures, while runs finish (and at the end)
-RUN_CPU_S = 7.0  # CPU-seconds of a run's processes (docs/benchmarks.md), at REFERENCE_LOOP_S
+RUN_CPU_S = 6.0  # CPU-seconds of a run's processes (docs/benchmarks.md), at REFERENCE_LOOP_S
 WARN_AFTER_S = 3600.0  # a study expected to take longer is announced with its estimate
 
 

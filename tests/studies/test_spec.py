@@ -162,9 +162,9 @@ def test_a_study_over_an_hour_is_announced_with_its_estimate(monkeypatch):
     monkeypatch.setattr(study, "python_loop_s", unmeasured)
     assert duration_note(60, 2) is None  # Table 3: minutes
     monkeypatch.setattr(study, "python_loop_s", lambda repeats=5: REFERENCE_LOOP_S)
-    assert duration_note(1000, 2) is None  # 3,500 s: just under the hour
-    note = duration_note(1_000_000, 2)  # 7 CPU-s a run on 2 cores: 3.5e6 s
-    assert note is not None and "about 40.5 days on 2 cores" in note
+    assert duration_note(1000, 2) is None  # 3,000 s: under the hour
+    note = duration_note(1_000_000, 2)  # 6 CPU-s a run on 2 cores: 3e6 s
+    assert note is not None and "about 34.7 days on 2 cores" in note
     assert "per core of the cluster" in duration_note(2000, None)
 
 
