@@ -1,5 +1,5 @@
 """The support MPC's NLPs compiled to shared libraries with the system C compiler, and cached
-(:mod:`mission.codegen.casadi_cache`): a plan takes about a quarter of the time it takes with
+(:mod:`mission.codegen.casadi_cache`): a plan takes about a fifth of the time it takes with
 casadi's interpreter. The first run generates and compiles (every NLP at once, one compiler
 process each); later runs load the cached libraries and build nothing.
 """

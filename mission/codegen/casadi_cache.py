@@ -113,7 +113,7 @@ def compiled_builds(
     builds: list[Build], fallback_dir: Callable[[], str], who: Compiling
 ) -> list[str | None]:
     """For each build, the functions its casadi solver needs (or the function), compiled into
-    a shared library with the system C compiler (about 4x faster plans than interpreting
+    a shared library with the system C compiler (about 5x faster plans than interpreting
     them), or None without one. The libraries not yet cached are compiled at the same time,
     one compiler process each.
 
