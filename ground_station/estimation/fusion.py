@@ -77,6 +77,8 @@ class FusionResult:
     def log_p(self, x: np.ndarray) -> np.ndarray:
         """log P(x) up to the constant alpha: sum over S of log f(x; mu_n, Sigma_n)."""
         x = np.atleast_2d(x)
+        if not self.densities:
+            return np.zeros(len(x))
         return sum(iter(log_densities(self.densities, x)), start=np.zeros(len(x)))
 
 
@@ -96,7 +98,10 @@ class LogDensity:
         return cls(mu, factor, 2.0 * np.sum(np.log(np.diag(factor))))
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
-        """log N(x; mu, sigma) for rows of x."""
+        """log N(x; mu, sigma) for rows of x (a scalar for one point given as a vector)."""
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 1:
+            return log_densities((self,), x[None])[0][0]
         return log_densities((self,), x)[0]
 
 

@@ -182,9 +182,7 @@ def build_support_nlp(
     forms = ["near", "far"] + (["near" + SOFT, "far" + SOFT] if slots else [])
     plugin = control.mpc_solver
     options = SOLVER_OPTIONS[plugin]
-    key = build_key(
-        [control, window.voxel_m, window.shape, with_prior, slots, plugin, options], NLP_BUILT_BY
-    )
+    key = nlp_key(control, window, with_prior, slots)
 
     def build(form: str) -> NlpBuild:
         return NlpBuild(f"support_mpc_{form}", plugin, symbolic()[0][form], options)
@@ -203,6 +201,15 @@ def build_support_nlp(
         # near's own f(x, p) is the cost: compiled, its library's "nlp" (f and g)
         cost = symbolic()[1] if libraries[0] is None else ca.external("nlp", libraries[0])
     return SupportNlp(solvers, BufferedFunction(cost, ("f",)))
+
+
+def nlp_key(control: ControlSettings, window: VoxelGrid, with_prior: bool, slots: int) -> str:
+    """The libraries' cache key: every argument the NLPs are built from (the window whole, its
+    origin included), the solver's options and the code that builds them."""
+    plugin = control.mpc_solver
+    return build_key(
+        [control, window, with_prior, slots, plugin, SOLVER_OPTIONS[plugin]], NLP_BUILT_BY
+    )
 
 
 def _symbolic_nlps(

@@ -10,6 +10,8 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+SOLVER_EXCEPTION = "SOLVER_RET_EXCEPTION"  # casadi's status for an exception inside the solver
+
 
 class BufferedFunction:
     """A casadi Function evaluated on arrays it owns: inputs are copied in, outputs copied out.
@@ -58,6 +60,8 @@ class BufferedFunction:
         except RuntimeError as error:
             if "error_on_fail" not in str(error):  # not a failed solve: a real error
                 raise
+            if self.stats().get("unified_return_status") == SOLVER_EXCEPTION:
+                raise  # the solver itself broke down, as casadi raised it without the option
             succeeded = False
         return {name: array.copy() for name, array in self._outputs.items()}, succeeded
 

@@ -25,7 +25,7 @@ LEAN = "nlp_grad without the unused gradients"  # in a build's recipe: the cache
 
 def wants_lean_gradient(options: dict) -> bool:
     """Whether a solver with these options never uses nlp_grad's p-gradient."""
-    return options.get("calc_lam_p", True) is False
+    return options.get("calc_lam_p", True) is False and not options.get("calc_multipliers")
 
 
 def lean_gradient(nlp: dict[str, ca.MX], with_x: bool) -> ca.Function:

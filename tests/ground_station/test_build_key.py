@@ -1,6 +1,8 @@
 """The support MPC's libraries cached under a key from what they are built from: a cache hit
-builds no expression, the key covers every module of the project the build runs (a stale
-solver would otherwise load) and every argument, and a hit plans as the build it stands for."""
+builds no expression, the key covers every module of the project whose functions the build
+calls (a stale solver would otherwise load) and every argument, and a hit plans as the build
+it stands for. The trace sees function calls: a constant read from an unlisted module would
+pass it, so the builders take what they need from their arguments and their own modules."""
 
 from __future__ import annotations
 
@@ -82,25 +84,48 @@ def test_the_margins_key_covers_every_module_their_build_runs(along_world, tmp_p
     assert ran <= _keyed(MARGIN_SPACES_BUILT_BY), "a module the key misses"
 
 
-def test_every_argument_and_every_source_changes_the_key(along_world, tmp_path):
-    control = along_world.scenario.control
-    base = build_key([control, (40, 40, 20), True], nlp.NLP_BUILT_BY)
+CHOICES = {"mpc_solver": ("fatrop", "ipopt"), "los_penalty": ("paper", "visible-point")}
+
+
+def _changed(name, value):
+    """Another value of a setting's type (another of its choices for a choice)."""
+    if name in CHOICES:
+        return next(choice for choice in CHOICES[name] if choice != value)
+    if isinstance(value, bool):
+        return not value
+    if isinstance(value, int | float):
+        return value + 1
+    return None
+
+
+def test_every_argument_the_build_takes_changes_the_key(along_world):
+    """nlp_key, which build_support_nlp keys its libraries by: every setting of the control
+    section, the window's origin, voxel and shape, the prior and the margins' slots."""
+    control, window = along_world.scenario.control, _window(along_world)
+    base = nlp.nlp_key(control, window, True, 3)
+    assert nlp.nlp_key(control, window, True, 3) == base
     for field in dataclasses.fields(control):
-        value = getattr(control, field.name)
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            continue
-        changed = dataclasses.replace(control, **{field.name: value + 1})
-        assert build_key([changed, (40, 40, 20), True], nlp.NLP_BUILT_BY) != base, field.name
-    assert build_key([control, (40, 40, 21), True], nlp.NLP_BUILT_BY) != base
-    assert build_key([control, (40, 40, 20), False], nlp.NLP_BUILT_BY) != base
-    # a module's source edited is another key
+        other = _changed(field.name, getattr(control, field.name))
+        assert other is not None, f"a setting of a new type: {field.name}"
+        changed = dataclasses.replace(control, **{field.name: other})
+        assert nlp.nlp_key(changed, window, True, 3) != base, field.name
+    moved = VoxelGrid(window.origin_m + 0.5, window.voxel_m, window.shape)
+    finer = VoxelGrid(window.origin_m, window.voxel_m / 2, window.shape)
+    wider = VoxelGrid(window.origin_m, window.voxel_m, (window.shape[0] + 1, *window.shape[1:]))
+    for other_window in (moved, finer, wider):
+        assert nlp.nlp_key(control, other_window, True, 3) != base
+    assert nlp.nlp_key(control, window, False, 3) != base
+    assert nlp.nlp_key(control, window, True, 2) != base
+
+
+def test_a_modules_source_edited_is_another_key(along_world, tmp_path):
     source = tmp_path / "builder.py"
     source.write_text("X = 1\n")
     module = type(sys)("builder")
     module.__file__ = str(source)
-    before = build_key([control], [module])
+    before = build_key([along_world.scenario.control], [module])
     source.write_text("X = 2\n")
-    assert build_key([control], [module]) != before
+    assert build_key([along_world.scenario.control], [module]) != before
 
 
 def test_arrays_are_keyed_by_every_value_not_their_printed_form():

@@ -56,3 +56,22 @@ def test_an_error_that_is_not_a_failed_solve_is_raised():
     _, buffered = _solver({**OPTIONS, "fatrop": {"print_level": 0, "no_such_option": 1}})
     with pytest.raises(RuntimeError, match="no_such_option"):
         buffered.solve(x0=[0.0, 0.0], p=1.0, ubg=1.0)
+
+
+def test_an_exception_inside_the_solver_is_raised_not_taken_for_a_failed_solve(monkeypatch):
+    _, buffered = _solver()
+    failed = "nlpsol process failed. Set 'error_on_fail' option to false to ignore this error."
+
+    def breaks():
+        raise RuntimeError(failed)
+
+    monkeypatch.setattr(buffered, "_evaluate", breaks)
+    for status, raised in (("SOLVER_RET_EXCEPTION", True), ("SOLVER_RET_LIMITED", False)):
+        monkeypatch.setattr(
+            buffered, "stats", lambda status=status: {"unified_return_status": status}
+        )
+        if raised:
+            with pytest.raises(RuntimeError, match="error_on_fail"):
+                buffered.solve(x0=[0.0, 0.0], p=1.0, ubg=1.0)
+        else:
+            assert buffered.solve(x0=[0.0, 0.0], p=1.0, ubg=1.0)[1] is False

@@ -107,6 +107,12 @@ def test_densities_in_one_call_equal_each_alone_bit_for_bit():
         for z in [np.linalg.solve(d.factor, (x - d.mu).T)]
     ]
     assert np.array_equal(log_densities(densities, x), np.array(alone))
+    one = densities[0](x[0])  # a point as a vector: a scalar, as the one-at-a-time formula
+    z = np.linalg.solve(densities[0].factor, x[0] - densities[0].mu)
+    assert np.ndim(one) == 0
+    assert one == -0.5 * (np.sum(z * z, axis=0) + densities[0].log_det + 3 * np.log(2 * np.pi))
+    nothing = FusionResult(None, (), (), False, np.zeros((0, 0)), ())
+    assert np.array_equal(nothing.log_p(x[:4]), np.zeros(4))  # no support in S: log P = 0
 
 
 def test_correlation_matrix_matches_pearson_on_densities():
