@@ -22,7 +22,7 @@ from mission.bench.margins import bench_margins
 from mission.bench.multipath import bench_multipath
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
-from mission.bench.run_command import run_as_command
+from mission.bench.run_command import batch_wall_s, run_as_command
 from mission.bench.study import bench_studies
 from mission.bench.view import bench_view
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
@@ -290,13 +290,13 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     ``repeats`` runs (MPC helper where there is a core for it); the real-time factor of the
     same runs flown by multicopters in a 3 m/s wind (alternating with those), against 0.8 of
     the kinematic one; and the wall time of the full
-    Table 3 batch, estimated as trials x (sum of one run per scenario and method, made as the
-    batch makes them) / jobs."""
+    Table 3 batch, estimated as trials x the wall time of one run per scenario and method made
+    as the batch makes them (``jobs`` at a time, whole commands)."""
     import tempfile
 
     from mission.studies.local_engine import helper_has_a_core
 
-    factors, walls, cpus, flying = [], [], [], []
+    factors, cpus, flying = [], [], []
     in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)
     with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
         multicopter = Path(temp) / "along-multicopter.yaml"
@@ -308,13 +308,11 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
             cpus.append(children_cpu_s() - before)
             out = Path(temp) / f"along-multicopter-{repeat}"
             flying.append(run_as_command(str(multicopter), "ac", out)["realtime_factor"])
-        for name in ("along", "wall"):
-            for method in ("ac", "nac"):
-                out = Path(temp) / f"batch-{name}-{method}"
-                walls.append(run_as_command(name, method, out, in_batch)["wall_time_s"])
+        batch = [(name, method) for name in ("along", "wall") for method in ("ac", "nac")]
+        batch_s = batch_wall_s(batch, Path(temp), jobs, in_batch)
     factor = statistics.median(factors)
     flying_ratio = statistics.median(flying) / factor
-    estimate = trials * sum(walls) / jobs
+    estimate = trials * batch_s  # the batch is that round of runs, trials times
     cpu = statistics.median(cpus)
     slowness = python_loop_s() / REFERENCE_LOOP_S  # this machine's speed, after the runs
     factor_target = REALTIME_FACTOR_TARGET / slowness
