@@ -23,7 +23,9 @@ from mission.bench.multipath import bench_multipath
 from mission.bench.result import BenchResult
 from mission.bench.roles import bench_roles
 from mission.bench.run_command import batch_wall_s, run_as_command
+from mission.bench.solver_ratios import interpreted_over_compiled, scipy_over_casadi
 from mission.bench.study import bench_studies
+from mission.bench.vehicle_step import bench_vehicle_step, vehicle_cpu_per_step_us
 from mission.bench.view import bench_view
 from mission.link.mavlink_udp import MavlinkCodec, MessageQueue, UdpEndpoint
 from mission.procs.machine_speed import REFERENCE_LOOP_S, children_cpu_s, python_loop_s
@@ -181,8 +183,8 @@ def bench_ground_station(
         medians.append(statistics.median(solves))
         p95s.append(float(np.percentile(solves, 95)))
         cycles_ms.append(statistics.median(o.cycle_ms for o in run.outputs))
-    ratio = _scipy_over_casadi(world, plan, scipy_problems)
-    interpreted = _interpreted_over_compiled(world, plan)
+    ratio = scipy_over_casadi(world, plan, scipy_problems)
+    interpreted = interpreted_over_compiled(world, plan)
     median, p95 = statistics.median(medians), statistics.median(p95s)
     cycle = statistics.median(cycles_ms)
     return [
@@ -192,96 +194,6 @@ def bench_ground_station(
         BenchResult("scipy_over_casadi_ratio", ratio, "x", ">= 10", ratio >= 10),
         BenchResult("interpreted_over_compiled_ratio", interpreted, "x", "reference", None),
     ]
-
-
-def _interpreted_over_compiled(world, plan, indices=range(2, 12)) -> float:
-    """Median plan time without a C compiler (casadi interprets the NLP) over the compiled
-    one's, on the three supports' problems at ten waypoints (the same plans either way)."""
-    import numpy as np
-
-    from ground_station.control.work_mpc import predict_work
-    from ground_station.support_mpc.mpc import SupportMpc
-
-    control, grid, sigma0 = world.scenario.control, world.map_grid(), world.sigma0_map().sigma_m
-    compiled = SupportMpc(control, grid, world.camera, sigma0)
-    interpreted = SupportMpc(control, grid, world.camera, sigma0, compiled=False)
-    requests = []
-    for i in indices:
-        work = predict_work(
-            plan.work[i], i + 1, plan.work, control.horizon_steps, control.d_max_work_m, 0.1
-        )
-        for n, waypoints in enumerate(plan.supports):
-            yhat = waypoints[i] + np.array([0.3, -0.2, 0.1])
-            requests.append(
-                compiled.request(
-                    f"support-{n + 1}", yhat, waypoints, work.path, work.indices, sigma0
-                )
-            )
-    medians = []
-    for mpc in (compiled, interpreted):
-        times = []
-        for request in requests * 3:
-            start = time.perf_counter()
-            mpc.plan(request, world.camera.observable)
-            times.append(time.perf_counter() - start)
-        medians.append(statistics.median(times))
-    return medians[1] / medians[0]
-
-
-def _scipy_over_casadi(world, plan, problems: int) -> float:
-    """Median time ratio SLSQP / our solver on the same support-MPC problems (optima within
-    1 cm)."""
-    from ground_station.support_mpc.mpc import SupportMpc
-
-    mpc = SupportMpc(world.scenario.control, world.map_grid(), world.camera)
-    g = world.sigma0_map().sigma_m
-    ratios = [_scipy_over_casadi_once(world, plan, mpc, g, i) for i in range(problems)]
-    agreeing = [ratio for ratio in ratios if ratio is not None]
-    return statistics.median(agreeing) if agreeing else float("nan")
-
-
-def _scipy_over_casadi_once(world, plan, mpc, g, i: int) -> float | None:
-    """SLSQP's time over ours on support 1's i-th problem; None if their optima differ."""
-    import numpy as np
-    from scipy.optimize import minimize
-
-    from ground_station.control.work_mpc import predict_work
-    from ground_station.support_mpc.cost_check import support_cost_numpy
-
-    control, grid = world.scenario.control, world.map_grid()
-    u, waypoints = control.horizon_steps, plan.supports[0]
-    yhat = waypoints[i] + np.array([0.3, -0.2, 0.1])
-    work = predict_work(
-        plan.work[i], i + 1, plan.work, u, control.d_max_work_m, control.arrival_tol_m
-    )
-    start = time.perf_counter()
-    result = mpc.solve(yhat, waypoints, work.path, work.indices, g, world.camera.observable)
-    casadi_s = time.perf_counter() - start
-    targets, terminal = waypoints[work.indices[:u]], waypoints[work.indices[u]]
-
-    def cost(x):
-        return support_cost_numpy(
-            x, yhat, targets, terminal, work.path[:u], result.blocked, g, grid, control,
-            result.anchors,
-        )  # fmt: skip
-
-    def steps_left(x):
-        v = x.reshape(-1, 3)
-        steps = np.vstack([v[0] - yhat, np.diff(v, axis=0)])
-        return control.d_max_support_m**2 - np.sum(steps**2, axis=1)
-
-    start = time.perf_counter()
-    reference = minimize(
-        cost,
-        mpc._initial_guess(yhat, terminal, None).ravel(),
-        method="SLSQP",
-        options={"maxiter": 300, "ftol": 1e-12},
-        constraints=[{"type": "ineq", "fun": steps_left}],
-    )
-    scipy_s = time.perf_counter() - start
-    if np.max(np.abs(reference.x.reshape(-1, 3) - result.path)) > 0.01:
-        return None
-    return scipy_s / casadi_s
 
 
 def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchResult]:
@@ -296,7 +208,7 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
 
     from mission.studies.local_engine import helper_has_a_core
 
-    factors, cpus, flying = [], [], []
+    factors, cpus, flying, vehicle_us = [], [], [], []
     in_batch = helper_has_a_core(jobs, os.cpu_count() or 1)
     with tempfile.TemporaryDirectory(prefix="bench-run-") as temp:
         multicopter = Path(temp) / "along-multicopter.yaml"
@@ -304,8 +216,10 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
         for repeat in range(repeats):  # alternately, so the machine's drift touches both
             out = Path(temp) / f"along-ac-{repeat}"
             before = children_cpu_s()
-            factors.append(run_as_command("along", "ac", out)["realtime_factor"])
+            summary = run_as_command("along", "ac", out)
             cpus.append(children_cpu_s() - before)
+            factors.append(summary["realtime_factor"])
+            vehicle_us.append(vehicle_cpu_per_step_us(summary))
             out = Path(temp) / f"along-multicopter-{repeat}"
             flying.append(run_as_command(str(multicopter), "ac", out)["realtime_factor"])
         batch = [(name, method) for name in ("along", "wall") for method in ("ac", "nac")]
@@ -314,6 +228,7 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     flying_ratio = statistics.median(flying) / factor
     estimate = trials * batch_s  # the batch is that round of runs, trials times
     cpu = statistics.median(cpus)
+    per_step = statistics.median(vehicle_us)
     slowness = python_loop_s() / REFERENCE_LOOP_S  # this machine's speed, after the runs
     factor_target = REALTIME_FACTOR_TARGET / slowness
     t3_target = TABLE3_WALL_TARGET_S * slowness
@@ -332,6 +247,7 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
         BenchResult(
             "run_cpu_s", cpu, "s", f"<= {RUN_OVER_DETACHED_TARGET:g} x detached_run_cpu_s", None
         ),
+        BenchResult("vehicle_cpu_per_step_us", per_step, "us", "reference", None),
         BenchResult(
             "table3_wall_s_estimate", estimate, "s", f"<= {t3_target:.0f}", estimate <= t3_target
         ),
@@ -340,7 +256,7 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
 
 BENCHMARKS: dict[str, Callable[[], list[BenchResult]]] = {
     "world": bench_sigma0_map,
-    "vehicle": bench_vehicle,
+    "vehicle": lambda: bench_vehicle() + bench_vehicle_step(),
     "gcs": bench_ground_station,
     "margins": bench_margins,
     "roles": bench_roles,
@@ -377,13 +293,20 @@ def run_benchmarks(
 
 
 def run_over_detached(results: list[BenchResult]) -> list[BenchResult]:
-    """A run's CPU over its decisions' alone, where one invocation read both (``--only run
-    --only floor``): the machine's speed cancels out."""
+    """Rows read against another of the same invocation, so that the machine's speed cancels
+    out: a run's CPU over its decisions' alone (``--only run --only floor``), and a vehicle's
+    step in a run over the same step warm (``--only run --only vehicle``)."""
     by_name = {result.name: result.value for result in results}
-    if "run_cpu_s" not in by_name or "detached_run_cpu_s" not in by_name:
-        return []
-    ratio = by_name["run_cpu_s"] / by_name["detached_run_cpu_s"]
-    target = RUN_OVER_DETACHED_TARGET
-    return [
-        BenchResult("run_over_detached_cpu_ratio", ratio, "x", f"<= {target:g}", ratio <= target)
-    ]
+    rows = []
+    if "run_cpu_s" in by_name and "detached_run_cpu_s" in by_name:
+        ratio = by_name["run_cpu_s"] / by_name["detached_run_cpu_s"]
+        target = RUN_OVER_DETACHED_TARGET
+        rows.append(
+            BenchResult(
+                "run_over_detached_cpu_ratio", ratio, "x", f"<= {target:g}", ratio <= target
+            )
+        )
+    if "vehicle_cpu_per_step_us" in by_name and "vehicle_step_warm_us" in by_name:
+        ratio = by_name["vehicle_cpu_per_step_us"] / by_name["vehicle_step_warm_us"]
+        rows.append(BenchResult("vehicle_run_over_warm_ratio", ratio, "x", "reference", None))
+    return rows

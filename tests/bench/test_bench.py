@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
@@ -42,8 +43,8 @@ def test_gcs_rows_are_medians_over_repeats_with_verdicts(monkeypatch):
     monkeypatch.setattr(
         mission.bench.detached, "run_detached", lambda *args, **kwargs: next(repeats)
     )
-    monkeypatch.setattr(bench, "_scipy_over_casadi", lambda *args: 12.0)
-    monkeypatch.setattr(bench, "_interpreted_over_compiled", lambda *args: 4.5)
+    monkeypatch.setattr(bench, "scipy_over_casadi", lambda *args: 12.0)
+    monkeypatch.setattr(bench, "interpreted_over_compiled", lambda *args: 4.5)
     rows = {r.name: r for r in bench.bench_ground_station(cycles=5, repeats=3)}
     # per-repeat medians 3, 4, 9 -> 4; p95s (linear) 80.8, 161, 9 -> 80.8; cycles 10, 20, 50 -> 20
     assert rows["support_mpc_solve_ms_median"].value == pytest.approx(4.0)
@@ -75,8 +76,13 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
             text = Path(scenario).read_text()
             assert "dynamics: multicopter" in text and "speed_m_s: 3.0" in text
             return {"realtime_factor": next(flying), "wall_time_s": 12.0}
-        if len(calls) <= 6:
-            return {"realtime_factor": next(factors), "wall_time_s": 9.0}
+        if len(calls) <= 6:  # the supports' CPU: 250, 600 and 900 us a step of 500
+            used = {1: 0.125, 3: 0.3, 5: 0.45}[len(calls)]
+            cpu = {"orchestrator": 9.0, "work": 9.0, **{f"support-{n}": used for n in (1, 2, 3)}}
+            return {
+                "realtime_factor": next(factors), "wall_time_s": 9.0, "cpu_s": cpu,
+                "control_cycles": 500,
+            }  # fmt: skip
         return {"realtime_factor": 1.0, "wall_time_s": {"along": 10.0, "wall": 12.0}[scenario]}
 
     monkeypatch.setattr(bench, "run_as_command", fake_run)
@@ -97,6 +103,7 @@ def test_run_rows_take_the_median_factor_and_estimate_the_batch_as_it_runs(monke
     factor = rows["realtime_factor_lockstep"]
     assert factor.value == 51.0 and factor.target == ">= 50" and factor.ok  # 100 x 0.146 / 0.292
     assert rows["run_cpu_s"].value == 4.0 and rows["run_cpu_s"].ok is None  # judged by the floor
+    assert rows["vehicle_cpu_per_step_us"].value == pytest.approx(600.0)  # the supports only
     assert rows["table3_wall_s_estimate"].target == "<= 300"
     assert [c[0] for c in calls[:6:2]] == ["along"] * 3  # alternating with the multicopter
     multicopter = rows["realtime_factor_multicopter"]
@@ -249,6 +256,52 @@ def test_a_run_is_set_against_its_floor_read_in_the_same_invocation(monkeypatch)
     (missed,) = rows(4.1, 2.5)
     assert not missed.ok
     assert rows(4.0, None) == []
+
+
+def test_a_vehicles_step_in_a_run_is_set_against_the_same_step_warm():
+    from mission.bench.result import BenchResult
+
+    in_run = BenchResult("vehicle_cpu_per_step_us", 600.0, "us", "reference", None)
+    warm = BenchResult("vehicle_step_warm_us", 240.0, "us", "reference", None)
+    (ratio,) = bench.run_over_detached([in_run, warm])
+    assert ratio.name == "vehicle_run_over_warm_ratio" and ratio.value == pytest.approx(2.5)
+    assert ratio.ok is None
+    assert bench.run_over_detached([in_run]) == []
+
+
+def test_a_runs_vehicle_cost_a_step_is_its_supports_mean_over_its_cycles():
+    from mission.bench.vehicle_step import vehicle_cpu_per_step_us
+
+    summary = {
+        "cpu_s": {"orchestrator": 1.0, "work": 0.9, "support-1": 0.2, "support-2": 0.4},
+        "control_cycles": 400,
+    }
+    assert vehicle_cpu_per_step_us(summary) == pytest.approx(750.0)
+    assert math.isnan(vehicle_cpu_per_step_us({"control_cycles": 400}))  # not said: no row
+
+
+def test_the_warm_step_flies_a_support_along_its_path_doing_a_runs_work(monkeypatch):
+    """One flight of the warm step: the support takes every setpoint and estimate (none
+    refused, no contact), publishes its sensors, and the time is per step."""
+    from mission.bench import vehicle_step
+    from vehicle_sim.vehicle import Vehicle
+
+    published, stepped = [], []
+    publish, step = Vehicle.publish, Vehicle.step
+
+    def counting_publish(self, work):
+        published.append(work)
+        return publish(self, work)
+
+    def counting_step(self, others=None):
+        stepped.append(sorted(others))
+        return step(self, others)
+
+    monkeypatch.setattr(Vehicle, "publish", counting_publish)
+    monkeypatch.setattr(Vehicle, "step", counting_step)
+    assert vehicle_step._warm_step_us() > 0
+    assert len(published) == len(stepped) > 100
+    assert stepped[0] == ["support-2", "support-3", "work"]
 
 
 def test_the_floor_refuses_a_detached_run_that_did_not_finish(monkeypatch):
