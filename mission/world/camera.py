@@ -116,7 +116,7 @@ class CameraModel:
         d = math.sqrt(float(z @ z))
         if not 0 < d <= reach:
             return Observation(False, None, d)
-        if self.structure is not None and self.structure.segments_blocked(observer, target)[0]:
+        if self.structure is not None and self.structure.segment_blocked(observer, target):
             return Observation(False, None, d)
         phi = math.asin(max(-1.0, min(1.0, z[2] / d)))
         theta = math.atan2(z[1], z[0])

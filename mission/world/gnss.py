@@ -9,6 +9,7 @@ a clock it cannot observe).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -65,6 +66,12 @@ class GnssModel:
         self._fix_geometry_by_mask: dict[bytes, tuple[np.ndarray | None, np.ndarray | None]] = {}
         self._geometry_by_mask: dict[bytes, tuple[bool, np.ndarray]] = {}
 
+    @cached_property
+    def _above_mask(self) -> tuple[np.ndarray, np.ndarray]:
+        """The satellites above the elevation mask and their directions (the sky is fixed)."""
+        masked_in = np.flatnonzero(self.sky.above_mask)
+        return masked_in, self._directions[masked_in]
+
     @property
     def geometry_rows(self) -> np.ndarray:
         """(S, 3 + constellations): each satellite's row of H, [-e^T, its clock's one-hot]."""
@@ -75,11 +82,11 @@ class GnssModel:
         points = np.atleast_2d(np.asarray(points, dtype=float))
         n_points, n_sats = len(points), len(self.sky.sv)
         visible = np.zeros((n_points, n_sats), dtype=bool)
-        masked_in = np.flatnonzero(self.sky.above_mask)
+        masked_in, above = self._above_mask
         if len(masked_in) == 0 or n_points == 0:
             return visible
         origins = np.repeat(points, len(masked_in), axis=0)
-        directions = np.tile(self._directions[masked_in], (n_points, 1))
+        directions = above if n_points == 1 else np.tile(above, (n_points, 1))
         blocked = self.structure.rays_blocked(origins, directions).reshape(n_points, -1)
         visible[:, masked_in] = ~blocked
         return visible

@@ -65,8 +65,11 @@ class KnownWorld:
     def in_workspace(self, points: np.ndarray) -> np.ndarray:
         """True for points inside the workspace box."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
-        lo, hi = np.array(self.workspace.min_m), np.array(self.workspace.max_m)
-        return np.all((points >= lo) & (points <= hi), axis=1)
+        lo, hi = self.workspace.min_m, self.workspace.max_m
+        if len(points) == 1:  # a setpoint: plain floats, the same comparisons
+            point = points[0].tolist()
+            return np.array([all(a <= x <= b for a, x, b in zip(lo, point, hi, strict=True))])
+        return np.all((points >= np.array(lo)) & (points <= np.array(hi)), axis=1)
 
     def placement_problem(self, point: np.ndarray) -> str | None:
         """Why a vehicle cannot be at ``point`` ("outside the workspace", "inside the

@@ -16,6 +16,8 @@ mesh file that is not convex, it holds near c only).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from mission.world.structure import Structure
@@ -28,6 +30,7 @@ class StructureProximity:
         self.low, self.high = structure.box_low, structure.box_high
         self._file_mesh = structure.file_mesh
         self._parts = structure.file_parts
+        self._boxes = list(zip(self.low.tolist(), self.high.tolist(), strict=True))
 
     @property
     def has_file_mesh(self) -> bool:
@@ -95,7 +98,23 @@ class StructureProximity:
         points = np.atleast_2d(np.asarray(points, dtype=float))
         if self.pieces == 0:
             return np.full(len(points), np.inf)
+        if len(points) == 1 and not self._parts and np.isfinite(points).all():
+            return np.array([self._box_distance(points[0].tolist())])
         return self.closest(points)[0].min(axis=1)
+
+    def _box_distance(self, point: list[float]) -> float:
+        """The least signed distance from one finite point to the boxes, as :meth:`closest`
+        gives it, in plain floats (a vehicle's every step): the same operations in the same
+        order (each squared gap summed x, y, z, as numpy sums three), so the same value."""
+        distances = []
+        for low, high in self._boxes:
+            below = [low[k] - point[k] for k in range(3)]
+            above = [point[k] - high[k] for k in range(3)]
+            depth = [max(below[k], above[k]) for k in range(3)]
+            out = [max(depth[k], 0.0) for k in range(3)]
+            gap = math.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
+            distances.append(max(depth) if gap == 0.0 else gap)
+        return min(distances)
 
     def clearance(self, points: np.ndarray) -> np.ndarray:
         """Distance from each point to whatever is nearer, the structure or the ground."""

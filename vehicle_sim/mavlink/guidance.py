@@ -73,10 +73,7 @@ def geofence_problem(
     if problem is not None:
         return "geofence", f"fence: {problem}"
     structure = world.structure
-    if (
-        np.linalg.norm(target - believed) > 0
-        and structure.segments_blocked(believed[None], target[None])[0]
-    ):
+    if np.linalg.norm(target - believed) > 0 and structure.segment_blocked(believed, target):
         return "geofence", "fence: crosses structure"
     return None
 
