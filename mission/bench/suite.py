@@ -228,7 +228,8 @@ def bench_runs(trials: int = 15, jobs: int = 2, repeats: int = 3) -> list[BenchR
     flying_ratio = statistics.median(flying) / factor
     estimate = trials * batch_s  # the batch is that round of runs, trials times
     cpu = statistics.median(cpus)
-    per_step = statistics.median(vehicle_us)
+    said = [us for us in vehicle_us if us == us]  # NaN where a run did not say its vehicles'
+    per_step = statistics.median(said) if said else float("nan")
     slowness = python_loop_s() / REFERENCE_LOOP_S  # this machine's speed, after the runs
     factor_target = REALTIME_FACTOR_TARGET / slowness
     t3_target = TABLE3_WALL_TARGET_S * slowness
@@ -289,10 +290,10 @@ def run_benchmarks(
             progress.flush()
             results.extend(bench())
             progress.write(f"bench: {name} done in {time.monotonic() - start:.0f} s\n")
-    return results + run_over_detached(results)
+    return results + same_invocation_ratios(results)
 
 
-def run_over_detached(results: list[BenchResult]) -> list[BenchResult]:
+def same_invocation_ratios(results: list[BenchResult]) -> list[BenchResult]:
     """Rows read against another of the same invocation, so that the machine's speed cancels
     out: a run's CPU over its decisions' alone (``--only run --only floor``), and a vehicle's
     step in a run over the same step warm (``--only run --only vehicle``)."""

@@ -5,9 +5,9 @@ setpoint and estimate from their packets and take them (the fence's checks), ste
 other vehicles' moves (contact with them, the structure and the ground), publish the step's
 telemetry (the GNSS fix, the camera's measurement, the states) and encode it. The support flies
 its Along waypoints among the others flying theirs, one step after another, so the caches stay
-warm. ``vehicle_cpu_per_step_us`` of ``--only run`` is the same path in a run, where six other
-processes run between two steps of a vehicle: the two set side by side say what the process
-layout costs beyond the work itself (docs/benchmarks.md).
+warm. ``vehicle_cpu_per_step_us`` of ``--only run`` is a vehicle process's whole step in a run:
+this work, what only a process does (its loop, sockets, the truth channel), and six other
+processes running between two of its steps (docs/benchmarks.md, "A vehicle's step in a run").
 """
 
 from __future__ import annotations

@@ -105,21 +105,34 @@ class StructureProximity:
     def _box_distance(self, point: list[float]) -> float:
         """The least signed distance from one finite point to the boxes, as :meth:`closest`
         gives it, in plain floats (a vehicle's every step): the same operations in the same
-        order (each squared gap summed x, y, z, as numpy sums three), so the same value."""
-        distances = []
+        order (each squared gap summed x, y, z, as numpy sums three; the larger and smaller
+        of two as numpy's ``maximum`` and ``minimum`` pick them, the second on a tie of 0.0
+        and -0.0), so the same value, bit for bit."""
+        least = None
         for low, high in self._boxes:
             below = [low[k] - point[k] for k in range(3)]
             above = [point[k] - high[k] for k in range(3)]
-            depth = [max(below[k], above[k]) for k in range(3)]
-            out = [max(depth[k], 0.0) for k in range(3)]
+            depth = [_larger(below[k], above[k]) for k in range(3)]
+            out = [_larger(depth[k], 0.0) for k in range(3)]
             gap = math.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
-            distances.append(max(depth) if gap == 0.0 else gap)
-        return min(distances)
+            distance = _larger(_larger(depth[0], depth[1]), depth[2]) if gap == 0.0 else gap
+            least = distance if least is None else _smaller(least, distance)
+        return least
 
     def clearance(self, points: np.ndarray) -> np.ndarray:
         """Distance from each point to whatever is nearer, the structure or the ground."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
         return np.minimum(self.distance(points), points[:, 2])
+
+
+def _larger(a: float, b: float) -> float:
+    """numpy's ``maximum`` of two finite floats: ``a`` only if it is larger."""
+    return a if a > b else b
+
+
+def _smaller(a: float, b: float) -> float:
+    """numpy's ``minimum`` of two finite floats: ``a`` only if it is smaller."""
+    return a if a < b else b
 
 
 def segment_points(start: np.ndarray, end: np.ndarray, spacing_m: float) -> np.ndarray:

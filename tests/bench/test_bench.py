@@ -248,7 +248,7 @@ def test_a_run_is_set_against_its_floor_read_in_the_same_invocation(monkeypatch)
         found = [BenchResult("run_cpu_s", run_cpu, "s", "", None)]
         if floor_cpu is not None:
             found.append(BenchResult("detached_run_cpu_s", floor_cpu, "s", "reference", None))
-        return bench.run_over_detached(found)
+        return bench.same_invocation_ratios(found)
 
     (met,) = rows(4.0, 2.5)
     assert met.name == "run_over_detached_cpu_ratio" and met.value == pytest.approx(1.6)
@@ -263,10 +263,10 @@ def test_a_vehicles_step_in_a_run_is_set_against_the_same_step_warm():
 
     in_run = BenchResult("vehicle_cpu_per_step_us", 600.0, "us", "reference", None)
     warm = BenchResult("vehicle_step_warm_us", 240.0, "us", "reference", None)
-    (ratio,) = bench.run_over_detached([in_run, warm])
+    (ratio,) = bench.same_invocation_ratios([in_run, warm])
     assert ratio.name == "vehicle_run_over_warm_ratio" and ratio.value == pytest.approx(2.5)
     assert ratio.ok is None
-    assert bench.run_over_detached([in_run]) == []
+    assert bench.same_invocation_ratios([in_run]) == []
 
 
 def test_a_runs_vehicle_cost_a_step_is_its_supports_mean_over_its_cycles():
