@@ -131,7 +131,7 @@ class Structure:
         """True for points inside a solid of the structure (a box, or a watertight part of the
         mesh file)."""
         points = np.atleast_2d(np.asarray(points, dtype=float))
-        if len(points) == 1 and not self.file_parts:  # a setpoint: plain floats, 5x faster
+        if len(points) == 1 and not self.file_parts:  # a setpoint: plain floats, no set-up
             point = points[0].tolist()
             inside = any(
                 all(lo < x < hi for lo, x, hi in zip(low, point, high, strict=True))
