@@ -43,17 +43,15 @@ class BufferedFunction:
 
     def __call__(self, **inputs: np.ndarray | float) -> dict[str, np.ndarray]:
         """Evaluate with these inputs (by name); the named outputs, as fresh arrays."""
-        for name, value in inputs.items():
-            self._inputs[name][:] = value
+        self._take(inputs)
         self._evaluate()
-        return {name: array.copy() for name, array in self._outputs.items()}
+        return self._results()
 
     def solve(self, **inputs: np.ndarray | float) -> tuple[dict[str, np.ndarray], bool]:
         """A solver built with ``error_on_fail`` evaluated with these inputs: its named
         outputs (written even where it failed) and whether it succeeded, without the cost of
         :meth:`stats` (a dict of every timer, ~30 us) on a success."""
-        for name, value in inputs.items():
-            self._inputs[name][:] = value
+        self._take(inputs)
         try:
             self._evaluate()
             succeeded = True
@@ -63,7 +61,16 @@ class BufferedFunction:
             if self.stats().get("unified_return_status") == SOLVER_EXCEPTION:
                 raise  # the solver itself broke down, as casadi raised it without the option
             succeeded = False
-        return {name: array.copy() for name, array in self._outputs.items()}, succeeded
+        return self._results(), succeeded
+
+    def _take(self, inputs: dict[str, np.ndarray | float]) -> None:
+        """Copy the given inputs into the arrays the buffer reads."""
+        for name, value in inputs.items():
+            self._inputs[name][:] = value
+
+    def _results(self) -> dict[str, np.ndarray]:
+        """The named outputs of the last evaluation, as fresh arrays."""
+        return {name: array.copy() for name, array in self._outputs.items()}
 
     def stats(self) -> dict:
         """The statistics of the last evaluation (for a solver: return_status, iter_count)."""
